@@ -1,0 +1,44 @@
+#pragma once
+// The mesh families of the paper (CONVENTIONS.md section 4), all on the unit sphere; maps to other
+// shapes live with the analytic surfaces (bendlab/surfaces).
+//
+//   MT1:  icosahedron, k Loop subdivision steps (Loop's rules for the new edge points and for the
+//         old vertices), every node projected radially onto the unit sphere after each step.
+//   MT2:  icosahedron, k midpoint subdivision steps, projected after each step.
+//   Octa: octahedron, k midpoint subdivision steps, projected after each step.
+//   Inhomogeneous: a sphere mesh followed by passes of Rivara's longest-edge bisection.
+// N_T = 20 * 4^k (icosahedron) or 8 * 4^k (octahedron).
+#include <string>
+
+#include "bendlab/mesh/trimesh.hpp"
+
+namespace bendlab {
+
+enum class MeshFamily { MT1, MT2, Octa };
+
+/// "mt1", "mt2", "octa" (case-insensitive); throws bendlab::Error otherwise.
+MeshFamily parse_mesh_family(const std::string& name);
+std::string to_string(MeshFamily family);
+
+/// Regular icosahedron (12 vertices, 20 faces) with its vertices on the unit sphere.
+TriMesh icosahedron();
+/// Regular octahedron (6 vertices, 8 faces) with its vertices on the unit sphere.
+TriMesh octahedron();
+
+/// One Loop subdivision step (each triangle -> 4). New edge point: 3/8 (a + b) + 1/8 (c + d);
+/// old vertex of valence n: (1 - n beta) v + beta sum(neighbours), Loop's
+/// beta = (5/8 - (3/8 + cos(2 pi / n) / 4)^2) / n. With project, every node is then moved
+/// radially onto the unit sphere.
+TriMesh refine_loop(const TriMesh& mesh, bool project_to_unit_sphere = true);
+/// One midpoint subdivision step (each triangle -> 4), new nodes at edge midpoints, then projected.
+TriMesh refine_midpoint(const TriMesh& mesh, bool project_to_unit_sphere = true);
+/// One pass of Rivara's longest-edge bisection: every triangle of the mesh as it was at the start
+/// of the pass is bisected at its longest edge, with conforming propagation (a neighbour that
+/// shares the edge is bisected too, after first bisecting it at its own longest edge when that
+/// is another edge). New nodes are projected onto the unit sphere when asked.
+TriMesh rivara_pass(const TriMesh& mesh, bool project_to_unit_sphere = true);
+
+/// The unit sphere of a family at refinement level k, then `rivara_passes` Rivara passes.
+TriMesh sphere_mesh(MeshFamily family, int level, int rivara_passes = 0);
+
+}  // namespace bendlab
