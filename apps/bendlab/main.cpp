@@ -24,7 +24,10 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    // A usage error: one line naming the problem, as for every other error.
+    std::cerr << "bendlab: error: " << e.what() << " (see --help)" << std::endl;
+    return e.get_exit_code();
   } catch (const std::exception& e) {
     // Commands do their work in callbacks, which run inside parse().
     std::cerr << "bendlab: error: " << e.what() << std::endl;

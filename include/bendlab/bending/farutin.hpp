@@ -1,0 +1,87 @@
+#pragma once
+// Method E (Farutin et al.; paper section 2.4.3): least-squares paraboloids on a node's
+// neighbourhood give the normal, H, K and, from a second paraboloid fitted to H, Lap H; then
+// f = 2 kB (Lap H + 2 H (H^2 - K)) n, eq. (10), with the signs of CONVENTIONS.md.
+//
+// The fit at node i, in the local frame (t1, t2, n0) with n0 the MWA normal and
+// (u, v) = ((x_j - x_i) . t1, (x_j - x_i) . t2):
+//   x_l(u, v) ~ x_l(0) + a_l u + b_l v + c_l u^2/2 + d_l uv + e_l v^2/2,   l = 1, 2, 3,
+// least squares over the neighbours, the node value exact. The three fits share one 5 x 5 normal
+// matrix, and because the data of the t1 and t2 components are u and v themselves (two columns of
+// the design matrix) their fits are exact: x_u = t1 + h_u n0, x_v = t2 + h_v n0, x_ab = h_ab n0,
+// where h(u, v) is the fit of the n0 component (the height above the tangent plane). So the
+// paper's three 5 x 5 systems reduce to one, with the same result (tested).
+//
+// Neighbourhood: rings 1..R of the breadth-first search (R = option "rings"), extended by further
+// rings while it holds fewer than 5 vertices or while the 5 x 5 system is singular.
+//
+// Lap H: the paraboloid H(u, v) ~ H_i + p u + q v + r u^2/2 + s uv + w v^2/2 is fitted over the
+// same neighbourhood in the same chart, with H_i fixed at the node's value (the same normal matrix
+// as the coordinate fit), and Lap H = g^ab (H_ab - Gamma^c_ab H_c) with the metric and the
+// Christoffel symbols Gamma^c_ab = g^cd x_d . x_ab of the coordinate fit at the node.
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "bendlab/bending/bending_method.hpp"
+#include "bendlab/core/types.hpp"
+#include "bendlab/geometry/mesh_geometry.hpp"
+#include "bendlab/mesh/topology.hpp"
+
+namespace bendlab {
+
+/// The coordinate fit of Method E at one node.
+struct FarutinFit {
+  Vec3 t1 = Vec3::Zero(), t2 = Vec3::Zero(), n0 = Vec3::Zero();  ///< chart frame, t1 x t2 = n0
+  double scale = 0;               ///< RMS tangential distance of the neighbours (column scaling)
+  Eigen::Vector2d grad = Eigen::Vector2d::Zero();  ///< (h_u, h_v)
+  Eigen::Matrix2d hess = Eigen::Matrix2d::Zero();  ///< (h_uu, h_uv; h_uv, h_vv)
+  Vec3 normal = Vec3::Zero();     ///< refined normal x_u x x_v / |.|, on the side of n0
+  double H = 0, K = 0;            ///< mean (> 0 on a sphere) and Gaussian curvature
+  int rings = 0;                  ///< rings of the neighbourhood used (0: no fit possible)
+  bool valid() const { return rings > 0; }
+};
+
+/// Fits the paraboloid at a node x0 from its neighbours' positions; normal_guess (unit) fixes the
+/// chart and the side of the normal. Returns a fit with rings = 1 on success and rings = 0 (and
+/// NaN H, K, normal) when the neighbours do not determine the paraboloid (fewer than 5, or a
+/// singular configuration).
+FarutinFit farutin_fit_point(const Vec3& x0, const Vec3& normal_guess, std::span<const Vec3> neighbours);
+
+/// Lap w at the node of `fit` from the values w0 at the node and w_neighbours at `neighbours`
+/// (the same neighbours as the fit, same order), by the quadratic fit described above.
+double farutin_laplacian_point(const FarutinFit& fit, const Vec3& x0, std::span<const Vec3> neighbours,
+                               double w0, std::span<const double> w_neighbours);
+
+/// The fit at every node, normal_guess the MWA normals; rings >= 1 (see the neighbourhood rule).
+std::vector<FarutinFit> farutin_fit(const Topology& topology, const Points& x, const Points& normal_guess,
+                                    int rings);
+
+/// Lap w at every node on the neighbourhoods and charts of `fits` (NaN where a fit is invalid).
+Scalars farutin_laplacian(const Topology& topology, const Points& x, const std::vector<FarutinFit>& fits,
+                          const Scalars& w);
+
+/// Eq. (10) from the fit's normal, H and K and the given lapH: f = 2 kB (lapH + 2 H (H^2 - K)) n,
+/// F = f * mixed area (eq. (14)), area = mixed area. Shared by Methods E and ED.
+BendingResult farutin_result(const std::vector<FarutinFit>& fits, Scalars lapH, const Scalars& mixed_area,
+                             double kappa_b);
+
+/// Reads the option "rings" (1, 2 or 3; default 1); throws bendlab::Error for any other option or
+/// value. Shared by Methods E and ED.
+int parse_farutin_rings(const MethodOptions& options, const std::string& method);
+
+/// Method E.
+class FarutinMethod : public BendingMethod {
+ public:
+  explicit FarutinMethod(int rings = 1);
+  static std::unique_ptr<BendingMethod> create(const MethodOptions& options);
+
+  std::string name() const override { return "E"; }
+  BendingResult compute(const Topology& topology, const Points& x, double kappa_b) const override;
+  int rings() const { return rings_; }
+
+ private:
+  int rings_;
+};
+
+}  // namespace bendlab

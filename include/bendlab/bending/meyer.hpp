@@ -1,0 +1,35 @@
+#pragma once
+// Method C (paper section 2.4.1): the force density of eq. (10) evaluated with Meyer et al.'s
+// discrete operators.
+//
+//   normal  n_i  : "mean weighted by angle" (MWA) of the face normals;
+//   H_i          : eq. (2), H = -1/2 (Lap x) . n, with the cotangent Laplacian of eq. (11) and
+//                  a_i = A_mixed_i (positive on a sphere);
+//   lapH_i       : eq. (11) applied again, to H;
+//   K_i          : angle defect over the mixed area, eq. (12);
+//   f_i          : eq. (10), f = 2 kB (lapH + 2 H (H^2 - K)) n (CONVENTIONS.md sign);
+//   F_i          : f_i A_mixed_i, eq. (14); area = A_mixed.
+// The paper writes eq. (11) as sum T_ij (w_i - w_j); here the Laplacian is div grad
+// (sum T_ij (w_j - w_i)), the sign with which eq. (10) holds. Method C has no energy.
+#include <memory>
+
+#include "bendlab/bending/bending_method.hpp"
+
+namespace bendlab {
+
+/// Assembles the result of a variational method (C, D, E, ...) from its per-vertex normal, H, K
+/// and lapH: f by eq. (10) with the CONVENTIONS.md sign, F = f * area by eq. (14). `area` is the
+/// mixed area. Moves the inputs into the result; energy stays empty.
+BendingResult assemble_variational_result(Points normal, Scalars H, Scalars K, Scalars lapH, Scalars area,
+                                          double kappa_b);
+
+class MeyerMethod final : public BendingMethod {
+ public:
+  /// Method C has no options; any option is an error (bendlab::Error naming it).
+  static std::unique_ptr<BendingMethod> create(const MethodOptions& options);
+
+  std::string name() const override { return "C"; }
+  BendingResult compute(const Topology& topology, const Points& x, double kappa_b) const override;
+};
+
+}  // namespace bendlab

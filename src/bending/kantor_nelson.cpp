@@ -1,0 +1,163 @@
+#include "bendlab/bending/kantor_nelson.hpp"
+
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "bendlab/geometry/mesh_geometry.hpp"
+
+namespace bendlab {
+
+namespace {
+
+bool parse_bool_option(const std::string& key, const std::string& value) {
+  if (value == "true" || value == "1" || value == "on" || value == "yes") return true;
+  if (value == "false" || value == "0" || value == "off" || value == "no") return false;
+  throw Error("method A: option '" + key + "' expects true or false, got '" + value + "'");
+}
+
+// theta / sin(theta) for theta in [0, pi), from s = sin(theta) >= 0 and theta. Below the
+// threshold the series 1 + theta^2/6 (next term 7 theta^4/360 < 1e-17) replaces the quotient,
+// so a flat edge (s = theta = 0) gives exactly 1 (footnote 1 of the paper).
+inline double theta_over_sin(double theta, double s) {
+  return theta < 1e-4 ? 1.0 + theta * theta / 6.0 : theta / s;
+}
+
+inline Vec3 xrow(const Points& x, int i) { return Vec3(x(i, 0), x(i, 1), x(i, 2)); }
+
+}  // namespace
+
+std::unique_ptr<BendingMethod> KantorNelson::create(const MethodOptions& options) {
+  bool small_angle = false;
+  for (const auto& [key, value] : options) {
+    if (key == "small_angle")
+      small_angle = parse_bool_option(key, value);
+    else
+      throw Error("method A: unknown option '" + key + "' (known: small_angle)");
+  }
+  return std::make_unique<KantorNelson>(small_angle);
+}
+
+// With c = n_f . n_g for the two faces f, g of an edge, eq. (6) is E_e = 2 kB~ (1 - c) and its
+// small-angle form E_e = kB~ theta^2, theta = acos(c). Writing the unnormalised face normal
+// m_f = (p1 - p0) x (p2 - p0), n_f = m_f / |m_f|, one has dn_f = (I - n_f n_f^T) dm_f / |m_f|, so
+//
+//   dc = W_fg . dm_f + W_gf . dm_g,   W_fg = (n_g - c n_f) / |m_f|,
+//
+// with no division by sin(theta). For the small-angle form dE_e/dc = -2 kB~ theta / sin(theta),
+// which tends to -2 kB~ at a flat edge. Collecting per face W_f = sum over its three edges of
+// dE_e/dc W_fg, and using d(W . m_f)/dp_k = (p_{k+1} - p_{k+2}) x W for corner k, the force is
+//
+//   F_i = - sum_{faces f at i, i = corner k} (p_{k+1} - p_{k+2}) x W_f.
+//
+// Both sums are gathers (faces over their edges, vertices over their one-ring faces), so the
+// loops run in parallel without write conflicts.
+double KantorNelson::energy_and_forces(const Topology& t, const Points& x, double kappa_b, Points& force) const {
+  const int nf = t.num_faces(), nv = t.num_vertices();
+  const Faces& F = t.faces();
+  const Faces& FE = t.face_edges();
+  const IndexPairs& EF = t.edge_faces();
+  const double kt = std::sqrt(3.0) * kappa_b;  // kB~ of eq. (6)
+  const bool small = small_angle_;
+
+  // normal[f] (unit) and inv_len[f] = 1 / |m_f|; then W[f].
+  std::vector<double> normal(3 * static_cast<size_t>(nf)), inv_len(nf), W(3 * static_cast<size_t>(nf));
+  force.resize(nv, 3);
+  const auto& roff = t.ring_offsets();
+  const auto& rfaces = t.ring_faces();
+  const auto& rcorners = t.ring_corners();
+  double energy = 0;
+
+#pragma omp parallel
+  {
+#pragma omp for schedule(static)
+    for (int f = 0; f < nf; ++f) {
+      const Vec3 p0 = xrow(x, F(f, 0)), p1 = xrow(x, F(f, 1)), p2 = xrow(x, F(f, 2));
+      const Vec3 m = (p1 - p0).cross(p2 - p0);
+      const double len = m.norm();
+      inv_len[f] = 1.0 / len;
+      for (int c = 0; c < 3; ++c) normal[3 * f + c] = m[c] / len;
+    }
+#pragma omp for schedule(static) reduction(+ : energy)
+    for (int f = 0; f < nf; ++f) {
+      const Vec3 nfv(normal[3 * f], normal[3 * f + 1], normal[3 * f + 2]);
+      Vec3 w = Vec3::Zero();
+      for (int k = 0; k < 3; ++k) {
+        const int e = FE(f, k);
+        const int g = EF(e, 0) == f ? EF(e, 1) : EF(e, 0);
+        const Vec3 ngv(normal[3 * g], normal[3 * g + 1], normal[3 * g + 2]);
+        const double c = nfv.dot(ngv);
+        double dEdc, Ee;
+        if (small) {
+          const double s = nfv.cross(ngv).norm();
+          const double theta = std::atan2(s, c);
+          Ee = kt * theta * theta;
+          dEdc = -2.0 * kt * theta_over_sin(theta, s);
+        } else {
+          Ee = kt * (nfv - ngv).squaredNorm();  // = 2 kB~ (1 - c), without cancellation near c = 1
+          dEdc = -2.0 * kt;
+        }
+        energy += 0.5 * Ee;  // each edge is visited from both of its faces
+        w += dEdc * (ngv - c * nfv);
+      }
+      w *= inv_len[f];
+      for (int c = 0; c < 3; ++c) W[3 * f + c] = w[c];
+    }
+#pragma omp for schedule(static)
+    for (int i = 0; i < nv; ++i) {
+      Vec3 s = Vec3::Zero();
+      for (int r = roff[i]; r < roff[i + 1]; ++r) {
+        const int f = rfaces[r], k = rcorners[r];
+        const Vec3 w(W[3 * f], W[3 * f + 1], W[3 * f + 2]);
+        s += (xrow(x, F(f, (k + 1) % 3)) - xrow(x, F(f, (k + 2) % 3))).cross(w);
+      }
+      force.row(i) = -s.transpose();
+    }
+  }
+  return energy;
+}
+
+void KantorNelson::forces(const Topology& t, const Points& x, double kappa_b, Points& force) const {
+  energy_and_forces(t, x, kappa_b, force);
+}
+
+std::optional<double> KantorNelson::energy(const Topology& t, const Points& x, double kappa_b) const {
+  const int ne = t.num_edges();
+  const Faces& F = t.faces();
+  const IndexPairs& EF = t.edge_faces();
+  const double kt = std::sqrt(3.0) * kappa_b;
+  auto unit_normal = [&](int f) {
+    const Vec3 p0 = xrow(x, F(f, 0)), p1 = xrow(x, F(f, 1)), p2 = xrow(x, F(f, 2));
+    return Vec3((p1 - p0).cross(p2 - p0).normalized());
+  };
+  double energy = 0;
+#pragma omp parallel for schedule(static) reduction(+ : energy)
+  for (int e = 0; e < ne; ++e) {
+    const Vec3 n0 = unit_normal(EF(e, 0)), n1 = unit_normal(EF(e, 1));
+    if (small_angle_) {
+      const double theta = std::atan2(n0.cross(n1).norm(), n0.dot(n1));
+      energy += kt * theta * theta;
+    } else {
+      energy += kt * (n0 - n1).squaredNorm();
+    }
+  }
+  return energy;
+}
+
+BendingResult KantorNelson::compute(const Topology& t, const Points& x, double kappa_b) const {
+  const int nv = t.num_vertices();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  BendingResult r;
+  r.energy = energy_and_forces(t, x, kappa_b, r.force);
+  MeshGeometry g = MeshGeometry::compute(t, x);
+  r.area = std::move(g.mixed_area);
+  r.normal = std::move(g.normal_mwa);
+  r.force_density.resize(nv, 3);
+  for (int i = 0; i < nv; ++i) r.force_density.row(i) = r.force.row(i) / r.area[i];  // eq. (14)
+  r.H = Scalars::Constant(nv, nan);
+  r.K = Scalars::Constant(nv, nan);
+  r.lapH = Scalars::Constant(nv, nan);
+  return r;
+}
+
+}  // namespace bendlab

@@ -1,0 +1,97 @@
+#include "bendlab/elasticity/neo_hookean.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+namespace bendlab {
+
+NeoHookean::NeoHookean(TopologyPtr topology, const Points& reference, double kS)
+    : topology_(std::move(topology)), kS_(kS) {
+  if (!(kS > 0) || !std::isfinite(kS)) throw Error(fmt::format("neo-Hookean: kS must be positive, got {}", kS));
+  const Topology& t = *topology_;
+  if (reference.rows() != t.num_vertices())
+    throw Error(fmt::format("neo-Hookean: {} reference positions for {} vertices", reference.rows(), t.num_vertices()));
+  const int nf = t.num_faces();
+  a0_.resize(nf); m00_.resize(nf); m01_.resize(nf); m11_.resize(nf);
+  const Faces& F = t.faces();
+  for (int f = 0; f < nf; ++f) {
+    const Vec3 x0 = row(reference, F(f, 0));
+    const Vec3 e1 = row(reference, F(f, 1)) - x0, e2 = row(reference, F(f, 2)) - x0;
+    const double g00 = e1.dot(e1), g01 = e1.dot(e2), g11 = e2.dot(e2);
+    const double det = g00 * g11 - g01 * g01;  // = (2 A0)^2
+    if (!(det > 0)) throw Error(fmt::format("neo-Hookean: reference triangle {} has zero area", f));
+    a0_[f] = 0.5 * std::sqrt(det);
+    m00_[f] = g11 / det;
+    m01_[f] = -g01 / det;
+    m11_[f] = g00 / det;
+    reference_area_ += a0_[f];
+  }
+  grad1_.resize(nf, 3);
+  grad2_.resize(nf, 3);
+  face_energy_.resize(nf);
+}
+
+double NeoHookean::energy(const Points& x) const {
+  const Faces& F = topology_->faces();
+  const int nf = topology_->num_faces();
+  double e = 0;
+#pragma omp parallel for reduction(+ : e) schedule(static)
+  for (int f = 0; f < nf; ++f) {
+    const Vec3 x0 = row(x, F(f, 0));
+    const Vec3 e1 = row(x, F(f, 1)) - x0, e2 = row(x, F(f, 2)) - x0;
+    const double g00 = e1.dot(e1), g01 = e1.dot(e2), g11 = e2.dot(e2);
+    const double trC = m00_[f] * g00 + 2 * m01_[f] * g01 + m11_[f] * g11;
+    const double detC = (g00 * g11 - g01 * g01) / (4 * a0_[f] * a0_[f]);
+    // I1 + 1/(I2+1) - 1 = trC - 2 + 1/detC - 1
+    e += a0_[f] * (trC + 1.0 / detC - 3.0);
+  }
+  return kS_ / 6.0 * e;
+}
+
+double NeoHookean::energy_and_forces(const Points& x, Points& force) const {
+  const Topology& t = *topology_;
+  const Faces& F = t.faces();
+  const int nf = t.num_faces(), nv = t.num_vertices();
+  if (force.rows() != nv) force.resize(nv, 3);
+  const double c = kS_ / 6.0;
+  double e = 0;
+#pragma omp parallel for reduction(+ : e) schedule(static)
+  for (int f = 0; f < nf; ++f) {
+    const Vec3 x0 = row(x, F(f, 0));
+    const Vec3 e1 = row(x, F(f, 1)) - x0, e2 = row(x, F(f, 2)) - x0;
+    const double g00 = e1.dot(e1), g01 = e1.dot(e2), g11 = e2.dot(e2);
+    const double s = 1.0 / (4 * a0_[f] * a0_[f]);
+    const double trC = m00_[f] * g00 + 2 * m01_[f] * g01 + m11_[f] * g11;
+    const double detC = (g00 * g11 - g01 * g01) * s;
+    e += a0_[f] * (trC + 1.0 / detC - 3.0);
+    // d trC / d e1 = 2 (M00 e1 + M01 e2),  d detC / d e1 = 2 s (g11 e1 - g01 e2),  likewise for e2;
+    // d(1/detC) = -d detC / detC^2.
+    const double k = a0_[f] * c, q = 2 * s / (detC * detC);
+    const Vec3 d1 = k * (2 * (m00_[f] * e1 + m01_[f] * e2) - q * (g11 * e1 - g01 * e2));
+    const Vec3 d2 = k * (2 * (m11_[f] * e2 + m01_[f] * e1) - q * (g00 * e2 - g01 * e1));
+    grad1_.row(f) = d1.transpose();
+    grad2_.row(f) = d2.transpose();
+  }
+  // Gather per vertex over its one-ring faces (CSR), so no two threads write one vertex.
+  const auto& rf = t.ring_faces();
+  const auto& rc = t.ring_corners();
+#pragma omp parallel for schedule(static)
+  for (int i = 0; i < nv; ++i) {
+    Eigen::RowVector3d g = Eigen::RowVector3d::Zero();
+    for (int k = t.ring_begin(i); k < t.ring_end(i); ++k) {
+      const int f = rf[k];
+      switch (rc[k]) {
+        case 0: g -= grad1_.row(f) + grad2_.row(f); break;
+        case 1: g += grad1_.row(f); break;
+        default: g += grad2_.row(f); break;
+      }
+    }
+    force.row(i) = -g;
+  }
+  return c * e;
+}
+
+void NeoHookean::forces(const Points& x, Points& force) const { energy_and_forces(x, force); }
+
+}  // namespace bendlab
