@@ -11,7 +11,8 @@
 // p) / 3. Half-space rule of section 2.4.2: only points p strictly above the plane through the
 // volume centroid c whose normal points from c to x_i, i.e. (p - c).(x_i - c) > 0, take part, so
 // that nodes close in space but far along the surface (the two dimples of a red blood cell) do not
-// see each other.
+// see each other. Points within a relative margin of 1e-9 of the plane count as on it (see
+// belkin.cpp), so that the rule does not depend on rounding for symmetric meshes.
 //
 // Cost: O(N^2) (every vertex sees every vertex), OpenMP over i. Terms whose exponent
 // |p - x_i|^2 / (4 a_i) exceeds 80 are skipped without calling exp: together they change
@@ -62,6 +63,7 @@ class BelkinLaplacian {
   BelkinOptions options_;
   int n_ = 0;
   std::vector<double> qx_, qy_, qz_;  ///< positions relative to the volume centroid (SoA)
+  std::vector<double> qnorm_;         ///< |x_p - c|
   Scalars lumped_area_;
   Scalars kernel_area_;               ///< a_i = A_mixed_i
 };
