@@ -1,0 +1,93 @@
+#pragma once
+// The static red-blood-cell benchmark of the paper's section 3.
+//
+// For every requested mesh family and refinement level with N_T <= max_triangles:
+//   unit-sphere mesh (sphere_mesh) -> RBC of eq. (15) (make_rbc()->map_from_unit_sphere, same
+//   topology) -> every bending method -> error measures of eq. (17) against the exact fields.
+//
+// Families and the meshes they give (family names as written in errors.csv):
+//   "mt1", "mt2"       levels 2, 3, ... : N_T = 320, 1280, 5120, 20480, 81920
+//   "octa"             levels 3, 4, ... : N_T = 512, 2048, 8192, ...
+//   "inhomogeneous"    "rivara-mt1" and "rivara-mt2": level 2 (320 triangles) of MT1 / MT2, then
+//                      three Rivara passes (about 3900 triangles). These two meshes are run
+//                      whatever max_triangles is, because table 3 needs them.
+// h is the mean edge length of the mapped (RBC) mesh.
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "bendlab/analysis/convergence.hpp"
+#include "bendlab/analysis/error_measures.hpp"
+#include "bendlab/bending/bending_method.hpp"
+#include "bendlab/mesh/trimesh.hpp"
+#include "bendlab/surfaces/analytic_surface.hpp"
+
+namespace bendlab {
+
+struct RbcStudyOptions {
+  std::vector<std::string> families = {"mt1", "mt2", "octa", "inhomogeneous"};
+  std::vector<std::string> methods = {"A", "B", "C", "D", "E", "ED"};
+  /// Options of the fitting methods (e.g. {"rings", "2"}): passed to E and ED; the other methods
+  /// take none.
+  MethodOptions method_options;
+  int max_triangles = 5120;
+  double kappa_b = 1.0;
+  double radius = 1.0;
+  /// Per-node data (numerical results, errors) are kept for meshes with N_T <= this, and for the
+  /// inhomogeneous meshes; larger meshes keep only the summaries.
+  int keep_nodes_max_triangles = 5120;
+  /// Called with one line per mesh and per method (with the time taken); may be empty.
+  std::function<void(const std::string&)> progress;
+};
+
+/// The families a study accepts.
+const std::vector<std::string>& rbc_study_families();
+/// Throws bendlab::Error (one line) for an unknown family or method, max_triangles < 320, a
+/// non-positive kappa_b or radius, or method options that a method refuses.
+void validate(const RbcStudyOptions& options);
+
+struct MethodRun {
+  std::string method;
+  double seconds = 0;                  ///< wall time of BendingMethod::compute
+  std::vector<ErrorSummary> errors;    ///< by kAllQuantities
+  bool has_nodes = false;
+  BendingResult result;                ///< when has_nodes
+  NodeErrors node_errors;              ///< when has_nodes
+};
+
+struct MeshRun {
+  std::string family;        ///< "mt1", "mt2", "octa", "rivara-mt1", "rivara-mt2"
+  std::string origin;        ///< homogeneous family of the mesh ("mt1" for "rivara-mt1")
+  bool inhomogeneous = false;
+  int level = 0, triangles = 0, vertices = 0;
+  double h = 0;              ///< mean edge length on the RBC
+  bool has_nodes = false;
+  TopologyPtr topology;      ///< when has_nodes
+  Points x;                  ///< RBC node positions, when has_nodes
+  Scalars theta;             ///< polar angle, eq. (16), when has_nodes
+  SurfaceFields analytic;    ///< exact fields at the nodes, when has_nodes
+  std::vector<MethodRun> methods;
+};
+
+struct RbcStudyResult {
+  RbcStudyOptions options;
+  SurfaceMaxima maxima;      ///< denominators of eq. (17)
+  std::vector<MeshRun> meshes;
+
+  /// One row per mesh, method and available quantity, in run order.
+  std::vector<ErrorRow> rows() const;
+};
+
+RbcStudyResult run_rbc_study(const RbcStudyOptions& options);
+
+/// Polar angle of each node, eq. (16): theta_i = arccos(z_i / |x_i|), in [0, pi].
+Scalars polar_angle(const Points& x);
+
+/// Markdown of table 2 for one family and measure ("max" or "avg"): rows K, H, lapH, f, n;
+/// one column per method; each cell the symbol and the slope on the finest meshes.
+std::string table2_markdown(const std::vector<RateFit>& fits, const std::string& family, const std::string& measure,
+                            const std::vector<std::string>& methods);
+/// Markdown of table 3 for one inhomogeneous family: symbol and the ratios max / avg.
+std::string table3_markdown(const std::vector<InhomogeneityCheck>& checks, const std::vector<std::string>& methods);
+
+}  // namespace bendlab

@@ -1,0 +1,285 @@
+#!/usr/bin/python3
+"""Writes docs/results/rbc.md from the output folder of `bendlab rbc`.
+
+    /usr/bin/python3 scripts/make_rbc_doc.py STUDY_DIR [RESULTS_DIR] [--command "..."]
+
+STUDY_DIR is the --out folder of `bendlab rbc` (after its plots were drawn). RESULTS_DIR (default
+docs/results of this repository) receives rbc.md and, in rbc/, the plots and the small tables
+(errors.csv, timings.csv, errors.json, table2.md, table3.md); the large per-node files stay in
+STUDY_DIR. --command is the command line quoted at the top of the document.
+
+Our tables 2 and 3 are set beside the paper's, transcribed below from
+  A. Guckenberger, M. P. Schraml, P. G. Chen, M. Leonetti, S. Gekle, "On the bending algorithms
+  for soft objects in flows", Comput. Phys. Commun. 207 (2016) 1-23, tables 2 and 3
+  (the specification, /work/shared/spec/000_f8e619346cfc3715.txt).
+The paper's tables use MT2 meshes for Methods A-E and MT1 for Method S; resolutions 320-81920.
+"""
+import json
+import math
+import os
+import shutil
+import sys
+
+PAPER_SOURCE = ("Guckenberger et al., *On the bending algorithms for soft objects in flows*, "
+                "Comput. Phys. Commun. 207 (2016), tables 2 and 3")
+PAPER_METHODS = ["A", "B", "C", "D", "E", "S"]
+# None: the method does not compute the quantity (empty cell in the paper).
+PAPER_TABLE2 = {
+    "max": {
+        "K": [None, None, "○", "○", "●", "○"],
+        "H": [None, None, "○", "●", "●", "○"],
+        "lapH": [None, None, "■", "○", "■", None],
+        "f": ["■", "■", "■", "○", "■", "■"],
+    },
+    "avg": {
+        "K": [None, None, "●", "●", "●", "●"],
+        "H": [None, None, "●", "●", "●", "●"],
+        "lapH": [None, None, "○", "●", "○", None],
+        "f": ["■", "○", "○", "●", "○", "○"],
+    },
+}
+PAPER_TABLE3_METHODS = ["A", "B", "C", "D", "E"]
+PAPER_TABLE3 = {
+    "K": [None, None, "■", "■", "■"],
+    "H": [None, None, "■", "●", "■"],
+    "lapH": [None, None, "■", "○", "■"],
+    "f": ["■", "■", "■", "○", "■"],
+}
+# What the paper's text (section 3 and appendix B, MT2) says about cells whose symbol is borderline:
+# quoted beside our explanation where the cell differs. Keyed by (measure, quantity, method).
+PAPER_TEXT = {
+    ("max", "lapH", "D"): "Appendix B: on MT2 'the maximal error for the otherwise very robust Method D starts to "
+                          "increase with resolutions beyond 20480 triangles'",
+    ("max", "f", "D"): "Appendix B: for f 'the same observation as for Lap H hold for Methods C-E' (D's maximal "
+                       "error grows beyond 20480 triangles on MT2)",
+    ("avg", "lapH", "D"): "Appendix B: on MT2 D's 'rate for the average error is reduced from O(h^2) to O(h)'",
+    ("avg", "f", "D"): "section 3.5: 'Method D appears to converge with O(h) only for the MT2 average error'",
+    ("avg", "lapH", "C"): "section 3.4: 'Regarding the average error measure, Method C retains a systematic "
+                          "deviation'",
+    ("avg", "f", "C"): "section 3.5: 'The averaged error remains roughly constant for C'",
+    ("avg", "lapH", "E"): "appendix B: on MT2 E's average error 'remains constant beyond 5120 triangles'",
+}
+MEANING2 = {"●": "convergence to zero", "○": "convergence to a systematic error", "■": "divergence"}
+MEANING3 = {"●": "no troubles", "○": "problems in the maximal error only",
+            "■": "a significant increase of both error measures"}
+QUANTITY_NAMES = {"K": "K", "H": "H", "lapH": "Lap H", "f": "f", "n": "n"}
+COPIED = ["errors.csv", "timings.csv", "errors.json", "table2.md", "table3.md"]
+
+
+def paper_cell(table, methods, quantity, method):
+    if method not in methods:
+        return None
+    return table[quantity][methods.index(method)]
+
+
+def fmt_slope(s):
+    return "n/a" if s is None else f"{s:+.1f}"
+
+
+def fmt_err(e):
+    return "n/a" if e is None else f"{e:.3g}"
+
+
+def explain_rate(fit, paper, thresholds, measure, max_paper_triangles=81920):
+    tri = fit["triangles"]
+    tail = min(len(tri), thresholds["tail_points"])
+    errs = fit["error"]
+    ours = fit["symbol"]
+    text = (f"our slope over the {tail} finest meshes ({tri[-tail]}-{tri[-1]} triangles) is "
+            f"{fmt_slope(fit['slope_tail'])}, between the two finest {fmt_slope(fit['slope_last'])} "
+            f"(error {fmt_err(errs[-2])} -> {fmt_err(errs[-1])}), which reads as {MEANING2.get(ours, ours)}; "
+            f"the paper saw {MEANING2[paper]}")
+    if tri[-1] < max_paper_triangles:
+        text += f" at resolutions up to {max_paper_triangles} (ours stop at {tri[-1]})"
+    # Name the case where the trend is only a matter of where the thresholds cut.
+    s = fit["slope_tail"]
+    if s is not None and (abs(s - thresholds["to_zero_slope"]) < 0.15 or abs(s - thresholds["diverge_slope"]) < 0.15):
+        text += "; the slope lies near a threshold, so the symbol is marginal"
+    quote = PAPER_TEXT.get((measure, fit["quantity"], fit["method"]))
+    if quote:
+        text += f" (the paper's text, {quote})"
+    return text + "."
+
+
+def explain_trouble(c, paper, factor):
+    return (f"at h = {c['h']:.4f} the {c['triangles']}-triangle mesh has maximal / average errors "
+            f"{fmt_err(c['max_error'])} / {fmt_err(c['avg_error'])}, {c['ratio_max']:.2g}x / {c['ratio_avg']:.2g}x "
+            f"the homogeneous {c['origin'].upper()} meshes at that h (threshold {factor}x), which reads as "
+            f"{MEANING3.get(c['symbol'], c['symbol'])}; the paper saw {MEANING3[paper]} on its 3848-triangle mesh.")
+
+
+def md_table(header, rows):
+    out = "| " + " | ".join(header) + " |\n|" + "---|" * len(header) + "\n"
+    for r in rows:
+        out += "| " + " | ".join(r) + " |\n"
+    return out
+
+
+def table2_section(study, family, measure):
+    fits = {(f["method"], f["quantity"]): f for f in study["rates"]
+            if f["family"] == family and f["measure"] == measure}
+    methods = study["options"]["methods"]
+    cols = list(dict.fromkeys(methods + PAPER_METHODS))
+    rows, diffs = [], []
+    for q in ["K", "H", "lapH", "f", "n"]:
+        cells = [QUANTITY_NAMES[q]]
+        for m in cols:
+            f = fits.get((m, q))
+            ours = f["symbol"] if f else ""
+            paper = paper_cell(PAPER_TABLE2[measure], PAPER_METHODS, q, m) if q in PAPER_TABLE2[measure] else None
+            paper_text = paper if paper else ("" if (m in PAPER_METHODS and q != "n") else "n/a")
+            if m == "S":
+                ours = "not implemented"
+            cells.append(f"{ours or '–'} / {paper_text or '–'}")
+            if f and paper and f["symbol"] != paper:
+                diffs.append([QUANTITY_NAMES[q], m, f["symbol"], paper,
+                              explain_rate(f, paper, study["thresholds"], measure)])
+        rows.append(cells)
+    return md_table(["quantity"] + cols, rows), diffs
+
+
+def table3_section(study, family):
+    checks = {(c["method"], c["quantity"]): c for c in study["inhomogeneous"] if c["family"] == family}
+    methods = study["options"]["methods"]
+    cols = list(dict.fromkeys(methods + PAPER_TABLE3_METHODS))
+    rows, diffs = [], []
+    factor = study["thresholds"]["inhomogeneous_factor"]
+    for q in ["K", "H", "lapH", "f", "n"]:
+        cells = [QUANTITY_NAMES[q]]
+        for m in cols:
+            c = checks.get((m, q))
+            paper = paper_cell(PAPER_TABLE3, PAPER_TABLE3_METHODS, q, m) if q in PAPER_TABLE3 else None
+            ours = f"{c['symbol']} ({c['ratio_max']:.2g} / {c['ratio_avg']:.2g})" if c and c["ratio_max"] is not None else "–"
+            cells.append(f"{ours} / {paper or '–'}")
+            if c and paper and c["symbol"] != paper:
+                diffs.append([QUANTITY_NAMES[q], m, c["symbol"], paper, explain_trouble(c, paper, factor)])
+        rows.append(cells)
+    return md_table(["quantity"] + cols, rows), diffs
+
+
+def main():
+    args = sys.argv[1:]
+    command = None
+    if "--command" in args:
+        i = args.index("--command")
+        command = args[i + 1]
+        del args[i:i + 2]
+    if not args or len(args) > 2:
+        sys.exit(__doc__)
+    study_dir = args[0]
+    repo = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    results = args[1] if len(args) > 1 else os.path.join(repo, "docs", "results")
+    with open(os.path.join(study_dir, "errors.json")) as f:
+        study = json.load(f)
+    asset_dir = os.path.join(results, "rbc")
+    os.makedirs(asset_dir, exist_ok=True)
+    pngs = sorted(n for n in os.listdir(study_dir) if n.endswith(".png"))
+    for name in COPIED + pngs:
+        shutil.copyfile(os.path.join(study_dir, name), os.path.join(asset_dir, name))
+
+    th = study["thresholds"]
+    opts = study["options"]
+    if command is None:
+        command = (f"build/release/bendlab rbc --max-triangles {opts['max_triangles']} "
+                   f"--families {','.join(opts['families'])} --methods {','.join(opts['methods'])}"
+                   + (f" --rings {opts['rings']}" if opts.get("rings") else "")
+                   + f" --out {study_dir} && /usr/bin/python3 scripts/make_rbc_doc.py {study_dir}")
+    md = []
+    md.append("# The static red blood cell (paper section 3)\n")
+    md.append("Generated; do not edit. Regenerate with\n\n```sh\n" + command + "\n```\n")
+    md.append("`bendlab rbc` runs the study, writes the tables and draws the plots (scripts/plot_rbc.py); "
+              "scripts/make_rbc_doc.py writes this page and copies the plots and small tables to `rbc/`.\n")
+
+    md.append("## Setup\n")
+    m = study["maxima"]
+    md.append(f"RBC of eq. (15), R = {study['radius']}, kB = {study['kappa_b']}. Error measures of eq. (17), "
+              f"normalised by the maxima over the whole surface: max|H| = {m['H']:.6g}, max|K| = {m['K']:.6g}, "
+              f"max|Lap H| = {m['lapH']:.6g}, max|f| = {m['f']:.6g}. h is the mean edge length of the RBC mesh.\n")
+    md.append(md_table(["family", "level", "triangles", "vertices", "h"],
+                       [[x["family"], str(x["level"]) + (" + 3 Rivara" if x["inhomogeneous"] else ""),
+                         str(x["triangles"]), str(x["vertices"]), f"{x['h']:.5f}"] for x in study["meshes"]]))
+    md.append("\nThe inhomogeneous meshes are the 320-triangle spheres after three passes of Rivara's bisection; "
+              "the paper reports 3914 (MT1) and 3848 (MT2) triangles, tie-breaking changes the count.\n")
+
+    md.append("## Table 2: convergence\n")
+    md.append(f"Symbols from the least-squares slope s of log(error) against log(1/h) on the finest meshes "
+              f"(error ~ h^-s): over the {th['tail_points']} finest meshes (s_tail) and between the two finest "
+              f"(s_last). ● converges to zero: s_tail <= {th['to_zero_slope']} and s_last <= {th['to_zero_slope']}; "
+              f"■ diverges: s_tail >= {th['diverge_slope']:+} or s_last >= {th['diverge_slope']:+}; "
+              f"○ converges to a systematic error: otherwise. Errors below {th['exact_error']:g} count as ●.\n")
+    md.append(f"Each cell: **ours / paper**. Paper: {PAPER_SOURCE}, which uses MT2 meshes for Methods A-E "
+              "and MT1 for S, so the comparison uses our MT2 meshes. Method S is not implemented here; ED (the "
+              "paper's proposed mixture: E for n, H, K and D's operator for Lap H) and the normal n are not in the paper's table. – : not computed.\n")
+    for measure, title in (("max", "maximal errors"), ("avg", "average errors")):
+        table, diffs = table2_section(study, "mt2", measure)
+        md.append(f"### Table 2 ({title}), MT2\n\n" + table)
+        if diffs:
+            md.append(f"\nCells where we differ from the paper ({title}):\n\n"
+                      + md_table(["quantity", "method", "ours", "paper", "explanation"], diffs))
+        else:
+            md.append("\nEvery cell the paper fills agrees.\n")
+    md.append("### Our MT1 version\n")
+    md.append("Cells: symbol (s_tail). See `rbc/table2.md` for the octahedron family too.\n")
+    with open(os.path.join(study_dir, "table2.md")) as f:
+        t2 = f.read()
+    for part in t2.split("\n## ")[1:]:
+        head, _, body = part.partition("\n")
+        if head.startswith("mt1"):
+            md.append(f"#### {head}\n" + body.strip() + "\n")
+
+    md.append("## Table 3: the inhomogeneous mesh\n")
+    md.append(f"Each cell: **ours (r_max / r_avg) / paper**, r = error of the inhomogeneous mesh divided by the "
+              f"error of its homogeneous family at the same h (log-log interpolation between the homogeneous "
+              f"meshes around it). ● no troubles: both r < {th['inhomogeneous_factor']}; ○ only the maximal error "
+              f"worse: r_max >= {th['inhomogeneous_factor']}, r_avg < {th['inhomogeneous_factor']}; ■ the average "
+              f"error worse too: r_avg >= {th['inhomogeneous_factor']}. Paper: {PAPER_SOURCE} (3848-triangle MT2 "
+              "mesh), so the comparison uses our Rivara mesh from MT2.\n")
+    for fam in ("rivara-mt2", "rivara-mt1"):
+        if not any(c["family"] == fam for c in study["inhomogeneous"]):
+            continue
+        table, diffs = table3_section(study, fam)
+        md.append(f"### {fam}\n\n" + table)
+        if fam == "rivara-mt2":
+            if diffs:
+                md.append("\nCells where we differ from the paper:\n\n"
+                          + md_table(["quantity", "method", "ours", "paper", "explanation"], diffs))
+            else:
+                md.append("\nEvery cell the paper fills agrees.\n")
+
+    md.append("## Plots\n")
+    md.append("Errors against 1/h with guide slopes h^1, h^2, h^-1, h^-2 (figures 3, 5, 7, 10 and, for MT2, "
+              "B.19-B.21, B.23); stars with a tick: the inhomogeneous mesh; open markers: the octahedron meshes "
+              "(512, 2048 triangles). Then the values against the polar angle theta (eq. 16) with the exact curve "
+              "(figures 4, 6, 8). Per-node errors for figure 9 / B.22 are in the .vtp files of the study folder "
+              "(errors_<family>_5120_<method>.vtp, fields eps_n, eps_H, eps_K, eps_lapH, eps_f).\n")
+    for fam in ("mt1", "mt2"):
+        for q in ("n", "H", "K", "lapH", "f"):
+            name = f"errors_{q}_{fam}.png"
+            if name in pngs:
+                md.append(f"![{QUANTITY_NAMES[q]} errors, {fam.upper()}](rbc/{name})\n")
+    for name in pngs:
+        if name.startswith("values_"):
+            md.append(f"![{name[:-4]}](rbc/{name})\n")
+
+    md.append("## Timings\n")
+    md.append("Wall-clock seconds of one `BendingMethod::compute` (every quantity of a method), one run, on the "
+              "machine that generated this page. The machine was shared and the methods use OpenMP, so times "
+              "below about 0.1 s are dominated by thread scheduling; compare the largest meshes.\n")
+    timings = study["timings"]
+    meshes = list(dict.fromkeys((t["family"], t["triangles"]) for t in timings))
+    methods = opts["methods"]
+    lookup = {(t["family"], t["triangles"], t["method"]): t["seconds"] for t in timings}
+    md.append(md_table(["mesh"] + methods,
+                       [[f"{fam} {n}"] + [f"{lookup.get((fam, n, me), math.nan):.3g}" for me in methods]
+                        for fam, n in meshes]))
+    md.append("\nAll numbers: [rbc/errors.csv](rbc/errors.csv) (family,triangles,h,method,quantity,max_error,"
+              "avg_error), [rbc/errors.json](rbc/errors.json) (also the fitted slopes), "
+              "[rbc/timings.csv](rbc/timings.csv).\n")
+    out = os.path.join(results, "rbc.md")
+    with open(out, "w") as f:
+        f.write("\n".join(md))
+    print(f"make_rbc_doc.py: wrote {out}", file=sys.stderr)
+
+
+if __name__ == "__main__":
+    main()

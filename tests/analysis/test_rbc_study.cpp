@@ -1,0 +1,107 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "bendlab/analysis/rbc_study.hpp"
+
+using namespace bendlab;
+
+TEST(RbcStudy, PolarAngle) {
+  Points x(4, 3);
+  x << 0, 0, 2, 0, 0, -1, 3, 0, 0, 1, 0, 1;
+  const Scalars t = polar_angle(x);
+  EXPECT_DOUBLE_EQ(t[0], 0);
+  EXPECT_DOUBLE_EQ(t[1], std::numbers::pi);
+  EXPECT_DOUBLE_EQ(t[2], std::numbers::pi / 2);
+  EXPECT_NEAR(t[3], std::numbers::pi / 4, 1e-15);
+}
+
+TEST(RbcStudy, RefusesBadOptions) {
+  RbcStudyOptions o;
+  o.families = {"mt3"};
+  EXPECT_THROW(validate(o), Error);
+  o = {};
+  o.max_triangles = 319;
+  EXPECT_THROW(validate(o), Error);
+  o = {};
+  o.methods = {"Z"};
+  EXPECT_THROW(validate(o), Error);
+  o = {};
+  o.methods = {"C", "C"};
+  EXPECT_THROW(validate(o), Error);
+  o = {};
+  o.families = {};
+  EXPECT_THROW(validate(o), Error);
+  o = {};
+  o.method_options = {{"rings", "7"}};  // reaches the fitting methods E and ED, which refuse it
+  EXPECT_THROW(validate(o), Error);
+  o.method_options = {{"rings", "2"}};
+  EXPECT_NO_THROW(validate(o));  // and only them: A-D take no options
+}
+
+TEST(RbcStudy, TinyStudyGivesEveryRowWithFiniteErrors) {
+  RbcStudyOptions o;
+  o.families = {"mt1"};
+  o.max_triangles = 1280;
+  int lines = 0;
+  o.progress = [&](const std::string&) { ++lines; };
+  const RbcStudyResult r = run_rbc_study(o);
+
+  // Denominators of eq. (17) for R = 1, kB = 1 (CONVENTIONS.md section 3).
+  EXPECT_NEAR(r.maxima.H, 2.20098, 1e-4);
+  EXPECT_NEAR(r.maxima.f, 189.457, 1e-2);
+
+  ASSERT_EQ(r.meshes.size(), 2u);
+  EXPECT_EQ(r.meshes[0].triangles, 320);
+  EXPECT_EQ(r.meshes[1].triangles, 1280);
+  EXPECT_GT(r.meshes[0].h, r.meshes[1].h);
+  EXPECT_EQ(lines, 2 * (1 + static_cast<int>(o.methods.size())));
+
+  std::size_t expected_rows = 0;
+  for (const MeshRun& m : r.meshes) {
+    ASSERT_EQ(m.methods.size(), o.methods.size());
+    EXPECT_TRUE(m.has_nodes);
+    EXPECT_EQ(m.theta.size(), m.vertices);
+    EXPECT_GE(m.theta.minCoeff(), 0.0);
+    EXPECT_LE(m.theta.maxCoeff(), std::numbers::pi);
+    for (const MethodRun& run : m.methods) {
+      EXPECT_GE(run.seconds, 0.0);
+      // Every method gives a force density; the variational ones also H and Lap H.
+      EXPECT_TRUE(run.errors[static_cast<int>(Quantity::F)].available) << run.method;
+      if (run.method == "C" || run.method == "D" || run.method == "E" || run.method == "ED") {
+        EXPECT_TRUE(run.errors[static_cast<int>(Quantity::H)].available) << run.method;
+        EXPECT_TRUE(run.errors[static_cast<int>(Quantity::LapH)].available) << run.method;
+      }
+      for (const ErrorSummary& s : run.errors) expected_rows += s.available;
+    }
+  }
+  const auto rows = r.rows();
+  EXPECT_EQ(rows.size(), expected_rows);
+  for (const ErrorRow& row : rows) {
+    EXPECT_TRUE(std::isfinite(row.max_error)) << row.method << " " << row.quantity;
+    EXPECT_TRUE(std::isfinite(row.avg_error)) << row.method << " " << row.quantity;
+    EXPECT_GE(row.max_error, row.avg_error) << row.method << " " << row.quantity;
+    EXPECT_GT(row.avg_error, 0.0) << row.method << " " << row.quantity;
+  }
+  // Two resolutions are enough for a slope in every series.
+  for (const RateFit& f : fit_rates(rows, {"mt1"})) EXPECT_NE(f.fit.trend, Trend::Undetermined);
+}
+
+TEST(RbcStudy, InhomogeneousMeshesComeFromTheirFamilies) {
+  RbcStudyOptions o;
+  o.families = {"inhomogeneous"};
+  o.methods = {"C"};
+  o.max_triangles = 320;  // does not limit the inhomogeneous meshes
+  const RbcStudyResult r = run_rbc_study(o);
+  ASSERT_EQ(r.meshes.size(), 2u);
+  EXPECT_EQ(r.meshes[0].family, "rivara-mt1");
+  EXPECT_EQ(r.meshes[0].origin, "mt1");
+  EXPECT_EQ(r.meshes[1].family, "rivara-mt2");
+  for (const MeshRun& m : r.meshes) {
+    EXPECT_TRUE(m.inhomogeneous);
+    // Three passes that bisect every triangle at least once: more than 320 * 2^3 triangles.
+    EXPECT_GT(m.triangles, 2560);
+    EXPECT_EQ(m.triangles % 2, 0);  // a closed triangle mesh has an even face count
+  }
+}
