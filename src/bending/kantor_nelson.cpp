@@ -25,6 +25,15 @@ inline double theta_over_sin(double theta, double s) {
 
 inline Vec3 xrow(const Points& x, int i) { return Vec3(x(i, 0), x(i, 1), x(i, 2)); }
 
+// Below this many faces a call takes a few microseconds and starting threads costs more than it saves.
+constexpr int kParallelMinFaces = 4096;
+
+// Scratch arrays of the force kernel, kept per calling thread and reused from call to call, so a
+// time loop does not allocate (and page in) fresh memory at every step.
+struct Workspace {
+  std::vector<double> normal, inv_len, dEdc, W;
+};
+
 }  // namespace
 
 std::unique_ptr<BendingMethod> KantorNelson::create(const MethodOptions& options) {
@@ -50,25 +59,33 @@ std::unique_ptr<BendingMethod> KantorNelson::create(const MethodOptions& options
 //
 //   F_i = - sum_{faces f at i, i = corner k} (p_{k+1} - p_{k+2}) x W_f.
 //
-// Both sums are gathers (faces over their edges, vertices over their one-ring faces), so the
-// loops run in parallel without write conflicts.
+// Each loop writes only to its own element (faces, edges, vertices) and gathers from its
+// neighbours, so the loops run in parallel without write conflicts.
 double KantorNelson::energy_and_forces(const Topology& t, const Points& x, double kappa_b, Points& force) const {
-  const int nf = t.num_faces(), nv = t.num_vertices();
+  const int nf = t.num_faces(), nv = t.num_vertices(), ne = t.num_edges();
   const Faces& F = t.faces();
   const Faces& FE = t.face_edges();
   const IndexPairs& EF = t.edge_faces();
-  const double kt = std::sqrt(3.0) * kappa_b;  // kB~ of eq. (6)
-  const bool small = small_angle_;
-
-  // normal[f] (unit) and inv_len[f] = 1 / |m_f|; then W[f].
-  std::vector<double> normal(3 * static_cast<size_t>(nf)), inv_len(nf), W(3 * static_cast<size_t>(nf));
-  force.resize(nv, 3);
   const auto& roff = t.ring_offsets();
   const auto& rfaces = t.ring_faces();
   const auto& rcorners = t.ring_corners();
+  const double kt = std::sqrt(3.0) * kappa_b;  // kB~ of eq. (6)
+  const bool small = small_angle_;
+
+  static thread_local Workspace ws;
+  ws.normal.resize(3 * static_cast<size_t>(nf));  // unit face normals n_f
+  ws.inv_len.resize(nf);                          // 1 / |m_f|
+  ws.dEdc.resize(ne);                             // dE_e / dc per edge
+  ws.W.resize(3 * static_cast<size_t>(nf));       // W_f
+  double* normal = ws.normal.data();
+  double* inv_len = ws.inv_len.data();
+  double* dEdc = ws.dEdc.data();
+  double* W = ws.W.data();
+  force.resize(nv, 3);
+  auto nrm = [normal](int f) { return Vec3(normal[3 * f], normal[3 * f + 1], normal[3 * f + 2]); };
   double energy = 0;
 
-#pragma omp parallel
+#pragma omp parallel if (nf >= kParallelMinFaces)
   {
 #pragma omp for schedule(static)
     for (int f = 0; f < nf; ++f) {
@@ -79,26 +96,26 @@ double KantorNelson::energy_and_forces(const Topology& t, const Points& x, doubl
       for (int c = 0; c < 3; ++c) normal[3 * f + c] = m[c] / len;
     }
 #pragma omp for schedule(static) reduction(+ : energy)
+    for (int e = 0; e < ne; ++e) {
+      const Vec3 n0 = nrm(EF(e, 0)), n1 = nrm(EF(e, 1));
+      if (small) {
+        const double s = n0.cross(n1).norm();
+        const double theta = std::atan2(s, n0.dot(n1));
+        energy += kt * theta * theta;
+        dEdc[e] = -2.0 * kt * theta_over_sin(theta, s);
+      } else {
+        energy += kt * (n0 - n1).squaredNorm();  // = 2 kB~ (1 - c), without cancellation near c = 1
+        dEdc[e] = -2.0 * kt;
+      }
+    }
+#pragma omp for schedule(static)
     for (int f = 0; f < nf; ++f) {
-      const Vec3 nfv(normal[3 * f], normal[3 * f + 1], normal[3 * f + 2]);
+      const Vec3 nf_ = nrm(f);
       Vec3 w = Vec3::Zero();
       for (int k = 0; k < 3; ++k) {
         const int e = FE(f, k);
-        const int g = EF(e, 0) == f ? EF(e, 1) : EF(e, 0);
-        const Vec3 ngv(normal[3 * g], normal[3 * g + 1], normal[3 * g + 2]);
-        const double c = nfv.dot(ngv);
-        double dEdc, Ee;
-        if (small) {
-          const double s = nfv.cross(ngv).norm();
-          const double theta = std::atan2(s, c);
-          Ee = kt * theta * theta;
-          dEdc = -2.0 * kt * theta_over_sin(theta, s);
-        } else {
-          Ee = kt * (nfv - ngv).squaredNorm();  // = 2 kB~ (1 - c), without cancellation near c = 1
-          dEdc = -2.0 * kt;
-        }
-        energy += 0.5 * Ee;  // each edge is visited from both of its faces
-        w += dEdc * (ngv - c * nfv);
+        const Vec3 ng = nrm(EF(e, 0) == f ? EF(e, 1) : EF(e, 0));
+        w += dEdc[e] * (ng - nf_.dot(ng) * nf_);
       }
       w *= inv_len[f];
       for (int c = 0; c < 3; ++c) W[3 * f + c] = w[c];
@@ -131,7 +148,7 @@ std::optional<double> KantorNelson::energy(const Topology& t, const Points& x, d
     return Vec3((p1 - p0).cross(p2 - p0).normalized());
   };
   double energy = 0;
-#pragma omp parallel for schedule(static) reduction(+ : energy)
+#pragma omp parallel for schedule(static) reduction(+ : energy) if (t.num_faces() >= kParallelMinFaces)
   for (int e = 0; e < ne; ++e) {
     const Vec3 n0 = unit_normal(EF(e, 0)), n1 = unit_normal(EF(e, 1));
     if (small_angle_) {
