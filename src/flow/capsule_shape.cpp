@@ -1,0 +1,45 @@
+#include "bendlab/flow/capsule_shape.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+#include "bendlab/geometry/measures.hpp"
+
+namespace bendlab {
+
+CapsuleShape capsule_shape(const Topology& t, const Points& x) {
+  CapsuleShape s;
+  s.centroid = volume_centroid(t, x);
+  const Faces& F = t.faces();
+  Mat3 m = Mat3::Zero();
+  double v6 = 0;
+  for (int f = 0; f < t.num_faces(); ++f) {
+    const Vec3 p0 = row(x, F(f, 0)) - s.centroid, p1 = row(x, F(f, 1)) - s.centroid,
+               p2 = row(x, F(f, 2)) - s.centroid;
+    const double det = p0.dot(p1.cross(p2));
+    const Vec3 sum = p0 + p1 + p2;
+    m += (det / 120.0) * (p0 * p0.transpose() + p1 * p1.transpose() + p2 * p2.transpose() + sum * sum.transpose());
+    v6 += det;
+  }
+  s.volume = v6 / 6.0;
+  if (!(s.volume > 0)) throw Error(fmt::format("capsule shape: enclosed volume {} is not positive", s.volume));
+  s.second_moment = m;
+  s.inertia = m.trace() * Mat3::Identity() - m;
+  Eigen::SelfAdjointEigenSolver<Mat3> eig(m);  // eigenvalues ascending
+  const Vec3 ev = eig.eigenvalues();
+  auto half_axis = [&](double mk) { return std::sqrt(std::max(0.0, 5.0 * mk / s.volume)); };
+  s.a = half_axis(ev[2]);
+  s.b = half_axis(ev[1]);
+  s.c = half_axis(ev[0]);
+  s.long_axis = eig.eigenvectors().col(2);
+  s.D = (s.a - s.c) / (s.a + s.c);
+  // The eigenvector's sign is arbitrary: fold the angle of its x-z projection into (-pi/2, pi/2].
+  double th = std::atan2(s.long_axis.z(), s.long_axis.x());
+  if (th > M_PI / 2) th -= M_PI;
+  if (th <= -M_PI / 2) th += M_PI;
+  s.theta = th;
+  return s;
+}
+
+}  // namespace bendlab
