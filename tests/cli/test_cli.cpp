@@ -1,0 +1,154 @@
+// The command line as a user meets it: exit codes, one-line errors, files whole or absent.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct CliRun {
+  int status;
+  std::string out, err;
+};
+
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir = fs::temp_directory_path() / ("bendlab_cli_" + std::to_string(::getpid()) + "_" +
+                                       ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+  }
+  void TearDown() override { fs::remove_all(dir); }
+
+  CliRun run(const std::string& args) {
+    const fs::path o = dir / "stdout.txt", e = dir / "stderr.txt";
+    const std::string cmd = std::string(BENDLAB_CLI_PATH) + " " + args + " >" + o.string() + " 2>" + e.string();
+    const int rc = std::system(cmd.c_str());
+    return {WEXITSTATUS(rc), slurp(o), slurp(e)};
+  }
+  static std::string slurp(const fs::path& p) {
+    std::ifstream in(p);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+  }
+  void write(const fs::path& p, const std::string& text) { std::ofstream(p) << text; }
+  // A usage or input error: non-zero exit, exactly one line on stderr naming the problem, and no
+  // output file left behind.
+  void expect_refused(const CliRun& r, const std::string& problem, const fs::path& out) {
+    EXPECT_NE(r.status, 0);
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_NE(r.err.find(problem), std::string::npos) << "stderr: " << r.err;
+    EXPECT_FALSE(fs::exists(out)) << out;
+    for (const auto& entry : fs::directory_iterator(dir))
+      EXPECT_EQ(entry.path().filename().string().find(".tmp"), std::string::npos) << entry.path();
+  }
+  fs::path dir;
+};
+
+// A closed tetrahedron with outward faces, and variants with one defect each.
+const std::string kTetraVertices = "0 0 0\n1 0 0\n0 1 0\n0 0 1\n";
+const std::string kTetraFaces = "3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+
+std::string off(const std::string& vertices, const std::string& faces, int nv, int nf) {
+  return "OFF\n" + std::to_string(nv) + " " + std::to_string(nf) + " 0\n" + vertices + faces;
+}
+
+}  // namespace
+
+TEST_F(Cli, HelpOnEverySubcommand) {
+  for (const char* sub : {"mesh", "shape", "forces", "rbc", "shear"}) {
+    const CliRun r = run(std::string(sub) + " --help");
+    EXPECT_EQ(r.status, 0) << sub;
+    EXPECT_NE(r.out.find("--out"), std::string::npos) << sub << ": " << r.out;
+  }
+}
+
+TEST_F(Cli, MeshPrintsSummaryForEveryFormat) {
+  for (const char* ext : {"off", "ply", "obj", "vtp"}) {
+    const fs::path out = dir / (std::string("m.") + ext);
+    const CliRun r = run("mesh --family mt1 --level 2 --shape rbc --out " + out.string());
+    ASSERT_EQ(r.status, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["triangles"], 320);
+    EXPECT_EQ(j["vertices"], 162);
+    EXPECT_EQ(j["min_valence"], 5);
+    EXPECT_EQ(j["max_valence"], 6);
+    EXPECT_GT(j["mean_edge_length"].get<double>(), 0);
+    EXPECT_GT(j["min_angle_deg"].get<double>(), 0);
+    EXPECT_TRUE(fs::exists(out));
+  }
+  const CliRun octa = run("mesh --family octa --level 3 --out " + (dir / "o.off").string());
+  ASSERT_EQ(octa.status, 0) << octa.err;
+  EXPECT_EQ(nlohmann::json::parse(octa.out)["triangles"], 512);
+}
+
+TEST_F(Cli, ShapeAndForcesWriteTheDocumentedColumns) {
+  const fs::path mesh = dir / "rbc.off";
+  ASSERT_EQ(run("mesh --family mt1 --level 2 --shape rbc --out " + mesh.string()).status, 0);
+  const fs::path shape = dir / "shape.csv";
+  CliRun r = run("shape --mesh " + mesh.string() + " --shape rbc --out " + shape.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(slurp(shape).rfind("x,y,z,nx,ny,nz,H,K,lapH,fx,fy,fz", 0), 0u);
+  for (const char* m : {"A", "B", "C", "D", "E", "ED"}) {
+    const fs::path forces = dir / (std::string("forces_") + m + ".csv");
+    r = run("forces --mesh " + mesh.string() + " --method " + m + " --shape rbc --out " + forces.string());
+    ASSERT_EQ(r.status, 0) << m << ": " << r.err;
+    const std::string text = slurp(forces);
+    EXPECT_EQ(text.rfind("x,y,z,nx,ny,nz,H,K,lapH,fx,fy,fz,Fx,Fy,Fz,area,", 0), 0u) << m;
+    EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 163) << m;  // header + 162 vertices
+  }
+}
+
+TEST_F(Cli, RefusesBadMeshesWithOneLineNamingTheProblem) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"index out of range", off(kTetraVertices, "3 0 2 1\n3 0 1 3\n3 0 3 9\n3 1 2 3\n", 4, 4)},
+      {"repeated index", off(kTetraVertices, "3 0 2 1\n3 0 1 1\n3 0 3 2\n3 1 2 3\n", 4, 4)},
+      {"zero-area triangle", off("0 0 0\n1 0 0\n0 1 0\n0.5 0.5 0\n", kTetraFaces, 4, 4)},
+      {"non-finite coordinate", off("0 0 0\n1 0 0\n0 1 0\n0 0 nan\n", kTetraFaces, 4, 4)},
+      {"boundary edge", off(kTetraVertices, "3 0 2 1\n3 0 1 3\n3 0 3 2\n", 4, 3)},
+      {"inconsistent orientation", off(kTetraVertices, "3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 3 2\n", 4, 4)},
+      {"inward orientation", off(kTetraVertices, "3 0 1 2\n3 0 3 1\n3 0 2 3\n3 1 3 2\n", 4, 4)},
+      {"unreferenced vertex", off(kTetraVertices + "5 5 5\n", kTetraFaces, 5, 4)},
+      {"non-manifold edge",
+       off(kTetraVertices + "0 -1 0\n0 0 -1\n", kTetraFaces + "3 0 1 4\n3 0 4 5\n3 0 5 1\n3 1 5 4\n", 6, 8)},
+      {"non-manifold vertex",
+       off(kTetraVertices + "-1 0 0\n0 -1 0\n0 0 -1\n", kTetraFaces + "3 0 5 4\n3 0 4 6\n3 0 6 5\n3 4 5 6\n", 7, 8)},
+  };
+  for (const auto& [problem, text] : cases) {
+    const fs::path in = dir / "bad.off", out = dir / "out.csv";
+    write(in, text);
+    expect_refused(run("shape --mesh " + in.string() + " --shape sphere --out " + out.string()), problem, out);
+    expect_refused(run("forces --mesh " + in.string() + " --method C --out " + out.string()), problem, out);
+  }
+}
+
+TEST_F(Cli, RefusesBadArgumentsBeforeWork) {
+  const fs::path out = dir / "m.off";
+  expect_refused(run("mesh --family mt1 --level -1 --out " + out.string()), "--level", out);
+  expect_refused(run("mesh --family mt7 --level 2 --out " + out.string()), "--family", out);
+  expect_refused(run("mesh --family mt1 --level 2 --out " + (dir / "m.stl").string()), "extension", dir / "m.stl");
+  expect_refused(run("mesh --family mt1 --level 2 --radius -2 --out " + out.string()), "--radius", out);
+  expect_refused(run("mesh --family mt1 --level 2 --shape oblate --axes 1,2 --out " + out.string()), "oblate", out);
+  expect_refused(run("mesh --family mt1 --level 2 --out " + (dir / "nowhere" / "m.off").string()), "does not exist",
+                 dir / "nowhere" / "m.off");
+  const fs::path mesh = dir / "s.off";
+  ASSERT_EQ(run("mesh --family mt1 --level 1 --out " + mesh.string()).status, 0);
+  const fs::path csv = dir / "f.csv";
+  expect_refused(run("forces --mesh " + mesh.string() + " --method Z --out " + csv.string()), "--method", csv);
+  expect_refused(run("forces --mesh " + mesh.string() + " --method C --kappa-b nan --out " + csv.string()),
+                 "--kappa-b", csv);
+  expect_refused(run("forces --mesh " + (dir / "missing.off").string() + " --method C --out " + csv.string()),
+                 "missing.off", csv);
+  write(dir / "garbage.off", "OFF\n4 4 0\n0 0 zero\n");
+  expect_refused(run("shape --mesh " + (dir / "garbage.off").string() + " --shape sphere --out " + csv.string()),
+                 "garbage.off", csv);
+}
