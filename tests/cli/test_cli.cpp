@@ -152,3 +152,39 @@ TEST_F(Cli, RefusesBadArgumentsBeforeWork) {
   expect_refused(run("shape --mesh " + (dir / "garbage.off").string() + " --shape sphere --out " + csv.string()),
                  "garbage.off", csv);
 }
+
+TEST_F(Cli, ShearRefusesBadParametersBeforeWork) {
+  const fs::path out = dir / "run";
+  expect_refused(run("shear --G -0.1 --out " + out.string()), "--G", out);
+  expect_refused(run("shear --G inf --out " + out.string()), "--G", out);
+  expect_refused(run("shear --method C --kappa-b nan --out " + out.string()), "--kappa-b", out);
+  expect_refused(run("shear --t-end -1 --out " + out.string()), "--t-end", out);
+  expect_refused(run("shear --kappa-b 0.1 --out " + out.string()), "--method", out);
+  expect_refused(run("shear --mesh mt1:1000 --out " + out.string()), "1000", out);
+  expect_refused(run("shear --mesh " + (dir / "missing.off").string() + " --out " + out.string()), "missing.off", out);
+  write(dir / "open.off", off(kTetraVertices, "3 0 2 1\n3 0 1 3\n3 0 3 2\n", 4, 3));
+  expect_refused(run("shear --mesh " + (dir / "open.off").string() + " --out " + out.string()), "boundary edge", out);
+  expect_refused(run("shear --resume --out " + out.string()), "checkpoint", out);
+}
+
+TEST_F(Cli, ShearWritesItsFilesAndResumes) {
+  const fs::path out = dir / "run";
+  CliRun r = run("shear --mesh mt1:320 --G 0.1 --t-end 0.3 --snapshot-every 0.1 --no-plot --out " + out.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const char* f : {"timeseries.csv", "summary.json", "shapes.pvd", "checkpoint.json", "snapshot_00000.vtp"})
+    EXPECT_TRUE(fs::exists(out / f)) << f;
+  const auto summary = nlohmann::json::parse(slurp(out / "summary.json"));
+  EXPECT_GT(summary["D_steady"].get<double>(), 0);
+  EXPECT_NEAR(summary["final_volume"].get<double>(), summary["initial_volume"].get<double>(),
+              1e-10 * summary["initial_volume"].get<double>());
+  EXPECT_EQ(slurp(out / "timeseries.csv").rfind("gamma_t,D,theta,volume,area,E_bend,E_elastic,dt\n", 0), 0u);
+  // Continue to 0.5: the rows up to 0.3 are kept and the series ends at 0.5.
+  r = run("shear --mesh mt1:320 --G 0.1 --t-end 0.5 --snapshot-every 0.1 --no-plot --resume --out " + out.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string series = slurp(out / "timeseries.csv");
+  const std::string last = series.substr(series.rfind('\n', series.size() - 2) + 1);
+  EXPECT_NEAR(std::stod(last.substr(0, last.find(','))), 0.5, 1e-12);
+  // A resume with other physics is refused.
+  expect_refused(run("shear --mesh mt1:320 --G 0.2 --t-end 0.6 --resume --out " + out.string()), "--G",
+                 out / "nothing");
+}
