@@ -19,6 +19,7 @@
 // same neighbourhood in the same chart, with H_i fixed at the node's value (the same normal matrix
 // as the coordinate fit), and Lap H = g^ab (H_ab - Gamma^c_ab H_c) with the metric and the
 // Christoffel symbols Gamma^c_ab = g^cd x_d . x_ab of the coordinate fit at the node.
+// With the height form: g = I + grad h grad h^T, Gamma^c_ab = h_ab h_c / W^2, W^2 = 1 + |grad h|^2.
 #include <memory>
 #include <span>
 #include <vector>
@@ -38,6 +39,10 @@ struct FarutinFit {
   Eigen::Matrix2d hess = Eigen::Matrix2d::Zero();  ///< (h_uu, h_uv; h_uv, h_vv)
   Vec3 normal = Vec3::Zero();     ///< refined normal x_u x x_v / |.|, on the side of n0
   double H = 0, K = 0;            ///< mean (> 0 on a sphere) and Gaussian curvature
+  /// Lap w = lap_weights . sum_j phi_j (w_j - w_i), phi_j the paraboloid basis at neighbour j in
+  /// the scaled chart: the Laplace-Beltrami of the fitted paraboloid, folded with the inverse of the
+  /// normal matrix, so that a field's Lap needs no second factorisation.
+  Eigen::Matrix<double, 5, 1> lap_weights = Eigen::Matrix<double, 5, 1>::Zero();
   int rings = 0;                  ///< rings of the neighbourhood used (0: no fit possible)
   bool valid() const { return rings > 0; }
 };
@@ -61,10 +66,12 @@ std::vector<FarutinFit> farutin_fit(const Topology& topology, const Points& x, c
 Scalars farutin_laplacian(const Topology& topology, const Points& x, const std::vector<FarutinFit>& fits,
                           const Scalars& w);
 
-/// Eq. (10) from the fit's normal, H and K and the given lapH: f = 2 kB (lapH + 2 H (H^2 - K)) n,
-/// F = f * mixed area (eq. (14)), area = mixed area. Shared by Methods E and ED.
-BendingResult farutin_result(const std::vector<FarutinFit>& fits, Scalars lapH, const Scalars& mixed_area,
-                             double kappa_b);
+/// Normal, H and K of every node, in vertex order (NaN where a fit is invalid).
+struct FarutinFields {
+  Points normal;
+  Scalars H, K;
+};
+FarutinFields farutin_fields(const std::vector<FarutinFit>& fits);
 
 /// Reads the option "rings" (1, 2 or 3; default 1); throws bendlab::Error for any other option or
 /// value. Shared by Methods E and ED.

@@ -1,0 +1,26 @@
+#include "bendlab/bending/mixed_ed.hpp"
+
+#include "bendlab/bending/belkin.hpp"
+#include "bendlab/bending/farutin.hpp"
+#include "bendlab/bending/meyer.hpp"
+#include "bendlab/geometry/mesh_geometry.hpp"
+
+namespace bendlab {
+
+MixedEDMethod::MixedEDMethod(int rings) : rings_(rings) {
+  if (rings < 1) throw Error("method ED: rings must be at least 1, got " + std::to_string(rings));
+}
+
+std::unique_ptr<BendingMethod> MixedEDMethod::create(const MethodOptions& options) {
+  return std::make_unique<MixedEDMethod>(parse_farutin_rings(options, "ED"));
+}
+
+BendingResult MixedEDMethod::compute(const Topology& topology, const Points& x, double kappa_b) const {
+  const MeshGeometry geometry = MeshGeometry::compute(topology, x);
+  FarutinFields e = farutin_fields(farutin_fit(topology, x, geometry.normal_mwa, rings_));
+  Scalars lapH = belkin_laplacian(topology, x, geometry, e.H);
+  return assemble_variational_result(std::move(e.normal), std::move(e.H), std::move(e.K), std::move(lapH),
+                                     geometry.mixed_area, kappa_b);
+}
+
+}  // namespace bendlab
