@@ -12,54 +12,76 @@ MeshGeometry MeshGeometry::compute(const Topology& t, const Points& x) {
   g.face_normal.resize(nf, 3);
   g.corner_angle.resize(nf, 3);
   g.corner_cot.resize(nf, 3);
-  g.edge_cot_weight = Scalars::Zero(ne);
-  g.voronoi_area = Scalars::Zero(nv);
-  g.mixed_area = Scalars::Zero(nv);
-  g.angle_sum = Scalars::Zero(nv);
-  g.normal_mwa = Points::Zero(nv, 3);
+  g.edge_cot_weight.resize(ne);
+  g.voronoi_area.resize(nv);
+  g.mixed_area.resize(nv);
+  g.angle_sum.resize(nv);
+  g.normal_mwa.resize(nv, 3);
+  g.gaussian_curvature.resize(nv);
+  // Each corner's share of the Voronoi and of the mixed area, gathered per vertex below.
+  CornerValues corner_voronoi(nf, 3), corner_mixed(nf, 3);
 
+  // Three passes, each free of write conflicts (faces, then edges, then vertices gathering over
+  // their CSR ring), so they run in parallel and sum in the same order for any thread count.
+#pragma omp parallel for schedule(static)
   for (int f = 0; f < nf; ++f) {
     const Vec3 p[3] = {x.row(F(f, 0)), x.row(F(f, 1)), x.row(F(f, 2))};
     const Vec3 n2 = (p[1] - p[0]).cross(p[2] - p[0]);  // twice the area times the unit normal
     const double two_area = n2.norm();
     g.face_area[f] = 0.5 * two_area;
     g.face_normal.row(f) = n2 / two_area;
+    double l2[3];  // l2[k] = squared length of the edge opposite corner k
     for (int k = 0; k < 3; ++k) {
       const Vec3 u = p[(k + 1) % 3] - p[k], w = p[(k + 2) % 3] - p[k];
       const double d = u.dot(w);
       g.corner_cot(f, k) = d / two_area;  // |u x w| = twice the area for every corner
       g.corner_angle(f, k) = std::atan2(two_area, d);
+      l2[k] = (p[(k + 2) % 3] - p[(k + 1) % 3]).squaredNorm();
     }
-    for (int k = 0; k < 3; ++k) {
-      g.edge_cot_weight[t.face_edges()(f, k)] += g.corner_cot(f, k);
-      const int i = F(f, k);
-      g.angle_sum[i] += g.corner_angle(f, k);
-      g.normal_mwa.row(i) += g.corner_angle(f, k) * g.face_normal.row(f);
-      // Voronoi part of corner k: the two edges at k, each weighted by the cotangent opposite it.
-      const double l_next2 = (p[(k + 1) % 3] - p[k]).squaredNorm();  // edge opposite corner k+2
-      const double l_prev2 = (p[(k + 2) % 3] - p[k]).squaredNorm();  // edge opposite corner k+1
-      const double vor = (l_next2 * g.corner_cot(f, (k + 2) % 3) + l_prev2 * g.corner_cot(f, (k + 1) % 3)) / 8.0;
-      g.voronoi_area[i] += vor;
-    }
-    // Mixed area (Meyer et al. 2002, fig. 4).
     int obtuse = -1;
     for (int k = 0; k < 3; ++k)
       if (g.corner_cot(f, k) < 0) obtuse = k;
     for (int k = 0; k < 3; ++k) {
-      const int i = F(f, k);
-      if (obtuse < 0) {
-        const double l_next2 = (p[(k + 1) % 3] - p[k]).squaredNorm();
-        const double l_prev2 = (p[(k + 2) % 3] - p[k]).squaredNorm();
-        g.mixed_area[i] += (l_next2 * g.corner_cot(f, (k + 2) % 3) + l_prev2 * g.corner_cot(f, (k + 1) % 3)) / 8.0;
-      } else {
-        g.mixed_area[i] += (k == obtuse ? 0.5 : 0.25) * g.face_area[f];
-      }
+      // Voronoi part of corner k, eq. (9): its two edges, each weighted by the cotangent opposite it.
+      const int k1 = (k + 1) % 3, k2 = (k + 2) % 3;
+      corner_voronoi(f, k) = (l2[k2] * g.corner_cot(f, k2) + l2[k1] * g.corner_cot(f, k1)) / 8.0;
+      // Mixed area (Meyer et al. 2002, fig. 4): Voronoi in non-obtuse triangles, else A/2 to the
+      // obtuse corner and A/4 to the others.
+      corner_mixed(f, k) = obtuse < 0 ? corner_voronoi(f, k) : (k == obtuse ? 0.5 : 0.25) * g.face_area[f];
     }
   }
-  g.gaussian_curvature.resize(nv);
+
+  const IndexPairs& ef = t.edge_faces();
+  const Faces& fe = t.face_edges();
+#pragma omp parallel for schedule(static)
+  for (int e = 0; e < ne; ++e) {
+    double w = 0;
+    for (int s = 0; s < 2; ++s) {
+      const int f = ef(e, s);
+      for (int k = 0; k < 3; ++k)
+        if (fe(f, k) == e) w += g.corner_cot(f, k);
+    }
+    g.edge_cot_weight[e] = w;
+  }
+
+  const auto& rf = t.ring_faces();
+  const auto& rc = t.ring_corners();
+#pragma omp parallel for schedule(static)
   for (int i = 0; i < nv; ++i) {
-    g.normal_mwa.row(i).normalize();
-    g.gaussian_curvature[i] = (2 * M_PI - g.angle_sum[i]) / g.mixed_area[i];
+    double angle = 0, voronoi = 0, mixed = 0;
+    Eigen::RowVector3d n = Eigen::RowVector3d::Zero();
+    for (int r = t.ring_begin(i); r < t.ring_end(i); ++r) {
+      const int f = rf[r], c = rc[r];
+      angle += g.corner_angle(f, c);
+      n += g.corner_angle(f, c) * g.face_normal.row(f);
+      voronoi += corner_voronoi(f, c);
+      mixed += corner_mixed(f, c);
+    }
+    g.angle_sum[i] = angle;
+    g.normal_mwa.row(i) = n.normalized();
+    g.voronoi_area[i] = voronoi;
+    g.mixed_area[i] = mixed;
+    g.gaussian_curvature[i] = (2 * M_PI - angle) / mixed;  // eq. (12)
   }
   return g;
 }

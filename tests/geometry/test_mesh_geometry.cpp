@@ -2,6 +2,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <omp.h>
+
 #include <iostream>
 #include <random>
 
@@ -174,4 +176,21 @@ TEST(MeshGeometry, ValenceStatistics) {
   EXPECT_EQ(s.max, 6);
   EXPECT_EQ(s.histogram[4], 6);
   EXPECT_NEAR(s.mean, 6.0 - 12.0 / m.num_vertices(), 1e-12);  // Euler: sum of valences = 6V - 12
+}
+
+TEST(MeshGeometry, SameBitsForAnyThreadCount) {
+  // Every pass gathers in a fixed order, so the thread count cannot change a single bit.
+  const TriMesh base = sphere_mesh(MeshFamily::MT2, 3, 1);
+  const TriMesh m = base.with_positions(make_rbc()->map_from_unit_sphere(base.positions()));
+  const int threads = omp_get_max_threads();
+  omp_set_num_threads(1);
+  const auto g1 = MeshGeometry::compute(m.topology(), m.positions());
+  omp_set_num_threads(3);
+  const auto g3 = MeshGeometry::compute(m.topology(), m.positions());
+  omp_set_num_threads(threads);
+  EXPECT_EQ(g1.mixed_area, g3.mixed_area);
+  EXPECT_EQ(g1.voronoi_area, g3.voronoi_area);
+  EXPECT_EQ(g1.normal_mwa, g3.normal_mwa);
+  EXPECT_EQ(g1.gaussian_curvature, g3.gaussian_curvature);
+  EXPECT_EQ(g1.edge_cot_weight, g3.edge_cot_weight);
 }
