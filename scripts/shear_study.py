@@ -1,0 +1,736 @@
+#!/usr/bin/python3
+"""The capsule-in-shear-flow study of the paper's section 4, regenerated from `bendlab shear` runs.
+
+    /usr/bin/python3 scripts/shear_study.py [--jobs N] [--t-end T] [--only a|b|c] [--bendlab PATH]
+                                            [--work DIR] [--doc FILE] [--triangles LIST]
+                                            [--triangles-a N] [--progress-every S]
+
+Quick check of the whole chain (a few minutes): --t-end 0.2 --triangles 320 --triangles-a 320
+--work /tmp/shear_preview --doc /tmp/shear_preview/shear.md. The full study (the defaults) is
+about an hour of CPU time, most of it Method A at 1280 triangles (gamma dt ~ 1e-3).
+
+Writes docs/results/shear.md and the PNGs it shows (docs/results/shear/):
+  (a) no bending, 1280 triangles, G = 0.0125 ... 0.2: D against gamma t (figure 12a) and the
+      steady D against G (figure 12b) with the small-G slope, small-deformation theory and the
+      published values at G = 0.1;
+  (b) methods A, B, C, D, E, ED at 320 and 1280 triangles for (G, kB_hat) = (0.05, 0.0375) and
+      (0.2, 0.15): D against gamma t, all methods in one plot per pair and resolution (figures 13
+      and 14);
+  (c) the average gamma dt over gamma t in [5, 10] (table 4) beside the paper's values, and the
+      wall time of every run.
+
+Every run is one `bendlab shear ... --no-plot` process whose output folder lies under --work
+(default results/shear_study). A run whose summary.json exists and matches the arguments is not
+run again; a run that was interrupted continues from its checkpoint (--resume). Interrupting the
+study and starting it again with the same options therefore loses at most the work since the last
+checkpoint of each running run.
+
+--only a|b|c runs only the runs of that part; the other parts appear in the document when all
+their runs are already in the work folder. --t-end below 10 gives a quick preview: the steady
+values and the average step size are then taken over the last half of each run (as
+`bendlab shear` does) and the document says so.
+"""
+import argparse
+import csv
+import json
+import math
+import os
+import platform
+import shlex
+import shutil
+import signal
+import subprocess
+import sys
+import threading
+import time
+from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+ROOT = Path(__file__).resolve().parent.parent
+METHODS = ["A", "B", "C", "D", "E", "ED"]
+G_SWEEP = [0.0125, 0.025, 0.05, 0.1, 0.2]
+PAIRS = [(0.05, 0.0375), (0.2, 0.15)]
+
+# Paper, table 4: average gamma dt over gamma t in [5, 10] chosen by the Cash-Karp stepper
+# (rtol 1e-7, atol 1e-6 R), BIM, MT1 meshes. Keys: (G, kB_hat) -> triangles -> method
+# ("none" is the kB_hat = 0 column). The paper has no column for ED.
+PAPER_TABLE4 = {
+    (0.05, 0.0375): {
+        320: {"none": "0.081", "A": "0.016", "B": "0.060", "C": "0.057", "D": "0.085", "E": "0.057"},
+        1280: {"none": "0.064", "A": "0.0015", "B": "0.0057", "C": "0.0056", "D": "0.063", "E": "0.0060"},
+        5120: {"none": "0.029", "A": "0.00014", "B": "0.00053", "C": "0.00052", "D": "0.0085", "E": "0.00056"},
+    },
+    (0.2, 0.15): {
+        320: {"none": "0.20", "A": "0.013", "B": "0.052", "C": "0.050", "D": "0.15", "E": "0.048"},
+        1280: {"none": "0.16", "A": "0.0012", "B": "0.0050", "C": "0.0049", "D": "0.078", "E": "0.0051"},
+        5120: {"none": "0.13", "A": "0.00011", "B": "0.00046", "C": "0.00046", "D": "0.0076", "E": "0.00048"},
+    },
+}
+
+# Published steady deformation at G = 0.1 without bending (5120 triangles and the references of
+# the paper's figure 12b: Le et al. 2009 and 2011, Pozrikidis 2001, Tsubota 2014,
+# Barthes-Biesel et al. 2010, Sinha et al. 2015): the values lie in this range.
+PUBLISHED_D_G01 = (0.37, 0.40)
+
+# Small-deformation theory (Barthes-Biesel & Rallison 1981) for an initially spherical capsule in
+# simple shear, any viscosity ratio: D = 5/4 Ca (2 + nu_s) / (1 + nu_s) with Ca = mu gamma R / Gs,
+# Gs the small-strain shear modulus and nu_s the surface Poisson ratio of the membrane
+# (equivalently D = Ca (15/8 + 5 Gs / (8 Ks)), Ks the area-dilatation modulus). The neo-Hookean law
+# has Ks = 3 Gs, nu_s = 1/2, so D = 25/12 Ca (the same as 25/4 mu gamma R / Es with the surface
+# Young modulus Es = 3 Gs). Our kS is 3 Gs (CONVENTIONS, section 2): Ca = 3 G and D = 25/4 G.
+SMALL_DEFORMATION_SLOPE = 25.0 / 4.0
+
+METHOD_STYLE = {
+    "none": dict(color="0.55", ls="--", lw=1.2),
+    "A": dict(color="tab:blue"), "B": dict(color="tab:orange"), "C": dict(color="tab:green"),
+    "D": dict(color="tab:red"), "E": dict(color="tab:purple"), "ED": dict(color="tab:brown", ls="-."),
+}
+
+_print_lock = threading.Lock()
+
+
+def say(msg):
+    with _print_lock:
+        print(msg, flush=True)
+
+
+def fmt_g(x):
+    """A number as it appears in folder names and on the command line."""
+    return f"{x:g}"
+
+
+@dataclass(frozen=True)
+class Run:
+    method: str  # "none" or a bending method
+    triangles: int
+    G: float
+    kappa_b: float
+    t_end: float
+
+    @property
+    def mesh(self):
+        return f"mt1:{self.triangles}"
+
+    @property
+    def name(self):
+        return (f"{self.method}_mt1-{self.triangles}_G{fmt_g(self.G)}_kb{fmt_g(self.kappa_b)}"
+                f"_t{fmt_g(self.t_end)}")
+
+    def label(self):
+        return (f"method {self.method:>4}, {self.triangles:4d} triangles, G = {fmt_g(self.G)}, "
+                f"kB_hat = {fmt_g(self.kappa_b)}")
+
+    def arguments(self, out):
+        return ["shear", "--method", self.method, "--mesh", self.mesh, "--G", fmt_g(self.G),
+                "--kappa-b", fmt_g(self.kappa_b), "--t-end", fmt_g(self.t_end), "--out", str(out),
+                "--no-plot"]
+
+
+@dataclass
+class Result:
+    run: Run
+    summary: dict | None = None
+    error: str | None = None
+    cached: bool = False
+    series: dict = field(default_factory=dict)
+
+    @property
+    def ok(self):
+        return self.summary is not None
+
+
+def close(a, b):
+    return a is not None and b is not None and abs(float(a) - float(b)) <= 1e-12 * max(1.0, abs(float(b)))
+
+
+def summary_matches(summary, run):
+    """Whether a summary.json was written by a run with the arguments of `run`."""
+    try:
+        return (summary.get("method") == run.method and summary.get("mesh") == run.mesh
+                and close(summary.get("G"), run.G) and close(summary.get("kappa_b_hat"), run.kappa_b)
+                and close(summary.get("t_end"), run.t_end))
+    except (TypeError, ValueError):
+        return False
+
+
+def read_summary(path):
+    try:
+        return json.loads(path.read_text())
+    except (OSError, ValueError):
+        return None
+
+
+def read_series(run_dir):
+    with open(run_dir / "timeseries.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    cols = {}
+    for key in ("gamma_t", "D", "theta", "volume", "dt"):
+        cols[key] = np.array([float(r[key]) for r in rows]) if rows else np.zeros(0)
+    return cols
+
+
+def checkpoint_matches(run_dir, run):
+    try:
+        args = json.loads((run_dir / "checkpoint.json").read_text())["arguments"]
+    except (OSError, ValueError, KeyError, TypeError):
+        return False
+    return (args.get("method") == run.method and args.get("mesh") == run.mesh
+            and close(args.get("G"), run.G) and close(args.get("kappa_b"), run.kappa_b))
+
+
+def execute(run, work, bendlab, counter, total):
+    """Runs (or reuses) one `bendlab shear` run and returns its Result."""
+    out = work / run.name
+    summary = read_summary(out / "summary.json")
+    if summary is not None and summary_matches(summary, run):
+        n = counter.next()
+        say(f"[{n:2d}/{total}] cached   {run.label()}: D_steady {summary['D_steady']:.4f}, "
+            f"mean gamma dt {summary['mean_gamma_dt']:.3g}, {summary['wall_seconds']:.0f} s")
+        return Result(run, summary, cached=True)
+
+    resume = summary is None and out.is_dir() and checkpoint_matches(out, run)
+    if not resume and out.exists():
+        shutil.rmtree(out)
+    out.mkdir(parents=True, exist_ok=True)
+    say(f"[  /{total}] {'resume ' if resume else 'start  '}  {run.label()}")
+    start = time.monotonic()
+    rc, err = _launch(run, out, bendlab, resume)
+    if rc != 0 and resume:
+        say(f"[  /{total}] resume failed, starting over: {run.label()}")
+        shutil.rmtree(out)
+        out.mkdir(parents=True)
+        rc, err = _launch(run, out, bendlab, False)
+    elapsed = time.monotonic() - start
+    summary = read_summary(out / "summary.json")
+    n = counter.next()
+    if rc != 0 or summary is None:
+        say(f"[{n:2d}/{total}] FAILED   {run.label()} (exit {rc}, {elapsed:.0f} s): {err}")
+        return Result(run, None, error=err or f"exit status {rc}")
+    say(f"[{n:2d}/{total}] done     {run.label()}: D_steady {summary['D_steady']:.4f}, "
+        f"mean gamma dt {summary['mean_gamma_dt']:.3g}, {summary['steps']} steps, "
+        f"{summary['wall_seconds']:.0f} s")
+    return Result(run, summary)
+
+
+class Stopped(Exception):
+    """The study was interrupted; the run was not finished."""
+
+
+_live = set()  # running bendlab processes
+_live_lock = threading.Lock()
+_stopping = threading.Event()
+
+
+def _launch(run, out, bendlab, resume):
+    cmd = [str(bendlab)] + run.arguments(out) + (["--resume"] if resume else [])
+    with open(out / "run.log", "a") as log:
+        log.write("$ " + shlex.join(cmd) + "\n")
+        log.flush()
+        with _live_lock:
+            if _stopping.is_set():
+                raise Stopped()
+            proc = subprocess.Popen(cmd, stdout=log, stderr=log, cwd=ROOT, start_new_session=True)
+            _live.add(proc)
+        try:
+            rc = proc.wait()
+        finally:
+            with _live_lock:
+                _live.discard(proc)
+    if _stopping.is_set():
+        raise Stopped()
+    err = ""
+    if rc != 0:
+        lines = [l for l in (out / "run.log").read_text().splitlines() if l.strip()]
+        err = lines[-1] if lines else ""
+    return rc, err
+
+
+def _on_sigterm(signum, frame):
+    raise KeyboardInterrupt()
+
+
+def report_running(work, elapsed):
+    """One line per running run: its latest progress line."""
+    with _live_lock:
+        dirs = [Path(p.args[p.args.index("--out") + 1]) for p in _live]
+    for d in sorted(dirs):
+        last = ""
+        try:
+            for line in (d / "run.log").read_text().splitlines():
+                if line.startswith("gamma t ="):
+                    last = line
+        except OSError:
+            pass
+        say(f"  [{elapsed / 60:5.1f} min] {d.name}: {' '.join(last.split()) or 'starting'}")
+
+
+def stop_all():
+    """Stops the study: no new runs, the running ones are terminated (they keep their checkpoint)."""
+    with _live_lock:
+        _stopping.set()
+        for proc in _live:
+            proc.terminate()
+
+
+class Counter:
+    def __init__(self):
+        self._n = 0
+        self._lock = threading.Lock()
+
+    def next(self):
+        with self._lock:
+            self._n += 1
+            return self._n
+
+
+def part_runs(part, t_end, triangles, triangles_a):
+    if part == "a":
+        return [Run("none", triangles_a, G, 0.0, t_end) for G in G_SWEEP]
+    if part == "b":
+        return [Run(m, n, G, kb, t_end) for (G, kb) in PAIRS for n in triangles for m in METHODS]
+    if part == "c":
+        return ([Run("none", n, G, 0.0, t_end) for (G, kb) in PAIRS for n in triangles]
+                + [Run(m, n, G, kb, t_end) for (G, kb) in PAIRS for n in triangles for m in METHODS])
+    raise ValueError(part)
+
+
+def cached_result(run, work):
+    summary = read_summary(work / run.name / "summary.json")
+    if summary is not None and summary_matches(summary, run):
+        return Result(run, summary, cached=True)
+    return None
+
+
+# ----------------------------------------------------------------------------- plots and tables
+
+def load_series(results, work):
+    for r in results.values():
+        if r.ok and not r.series:
+            try:
+                r.series = read_series(work / r.run.name)
+            except (OSError, ValueError, KeyError):
+                r.series = {}
+
+
+def num(x, digits=4):
+    if x is None or (isinstance(x, float) and not math.isfinite(x)):
+        return "n/a"
+    return f"{x:.{digits}g}"
+
+
+def steady_label(t_end):
+    return "[5, 10]" if t_end >= 10 else f"[{fmt_g(t_end / 2)}, {fmt_g(t_end)}]"
+
+
+def fit_slope(G, D):
+    """Least-squares slope of D = s G through the origin."""
+    G, D = np.asarray(G), np.asarray(D)
+    return float(np.dot(G, D) / np.dot(G, G))
+
+
+def section_a(results, runs, fig_dir, rel, t_end):
+    lines = ["## (a) No bending: deformation against shear rate (figure 12)", ""]
+    n = runs[0].triangles
+    ok = [results[r] for r in runs if results[r].ok]
+    bad = [results[r] for r in runs if not results[r].ok]
+    lines.append(f"Capsule without bending resistance (kB_hat = 0), MT1 mesh with {n} triangles, "
+                 f"gamma t from 0 to {fmt_g(t_end)}. The paper uses 5120 triangles.")
+    lines.append("")
+
+    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    for r in ok:
+        s = r.series
+        if s:
+            ax.plot(s["gamma_t"], s["D"], label=f"G = {fmt_g(r.run.G)}")
+    ax.set_xlabel(r"$\dot\gamma t$")
+    ax.set_ylabel("D")
+    ax.set_xlim(0, t_end)
+    ax.set_ylim(bottom=0)
+    ax.grid(alpha=0.3)
+    ax.legend()
+    ax.set_title(f"no bending, {n} triangles (cf. figure 12a)")
+    fig.tight_layout()
+    fig.savefig(fig_dir / "fig12a_D_time.png", dpi=110)
+    plt.close(fig)
+
+    G = np.array([r.run.G for r in ok])
+    D = np.array([r.summary["D_steady"] if r.summary["D_steady"] is not None else math.nan for r in ok])
+    good = np.isfinite(D)
+    G, D = G[good], D[good]
+    order = np.argsort(G)
+    G, D = G[order], D[order]
+    slope2 = fit_slope(G[:2], D[:2]) if len(G) >= 2 else math.nan
+    slope3 = fit_slope(G[:3], D[:3]) if len(G) >= 3 else math.nan
+
+    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    ax.plot(G, D, "o-", label=f"bendlab, {n} triangles")
+    gx = np.linspace(0, max(G.max() if len(G) else 0.2, 0.2), 50)
+    if math.isfinite(slope3):
+        ax.plot(gx[gx <= 0.08], slope3 * gx[gx <= 0.08], ":", color="tab:blue",
+                label=f"fit D = {slope3:.2f} G (three smallest G)")
+    ax.plot(gx[gx <= 0.08], SMALL_DEFORMATION_SLOPE * gx[gx <= 0.08], "k--",
+            label="small deformation: D = 25/4 G (= 25/12 Ca)")
+    lo, hi = PUBLISHED_D_G01
+    ax.errorbar([0.1], [(lo + hi) / 2], yerr=[[(hi - lo) / 2]], fmt="none", ecolor="tab:red", capsize=5,
+                lw=2, label="published range at G = 0.1 (figure 12b)")
+    ax.set_xlabel("G")
+    ax.set_ylabel(f"D averaged over $\\dot\\gamma t \\in$ {steady_label(t_end)}")
+    ax.set_xlim(0, gx[-1] * 1.05)
+    ax.set_ylim(bottom=0)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    ax.set_title(f"steady deformation, no bending (cf. figure 12b)")
+    fig.tight_layout()
+    fig.savefig(fig_dir / "fig12b_D_steady.png", dpi=110)
+    plt.close(fig)
+
+    lines += [f"![D against gamma t]({rel}/fig12a_D_time.png)", "",
+              f"![steady D against G]({rel}/fig12b_D_steady.png)", ""]
+    lines += [f"Steady values (time average over gamma t in {steady_label(t_end)}, weighted by the step "
+              "size), beside the small-deformation result D = 25/4 G:", "",
+              "| G | Ca = 3 G | D_steady | theta_steady / pi | 25/4 G | D_steady / (25/4 G) | mean gamma dt | steps | wall s |",
+              "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+    for r in sorted(ok, key=lambda r: r.run.G):
+        s = r.summary
+        lin = SMALL_DEFORMATION_SLOPE * r.run.G
+        d = s["D_steady"]
+        th = s["theta_steady"]
+        lines.append(f"| {fmt_g(r.run.G)} | {fmt_g(3 * r.run.G)} | {num(d)} | "
+                     f"{num(th / math.pi if th is not None else None)} | {lin:.4g} | "
+                     f"{num(d / lin if d is not None else None, 3)} | {num(s['mean_gamma_dt'], 3)} | "
+                     f"{s['steps']} | {s['wall_seconds']:.0f} |")
+    for r in bad:
+        lines.append(f"| {fmt_g(r.run.G)} | {fmt_g(3 * r.run.G)} | failed: {r.error} | | | | | | |")
+    lines.append("")
+    lo, hi = PUBLISHED_D_G01
+    d01 = next((r.summary["D_steady"] for r in ok if close(r.run.G, 0.1)), None)
+    lines += [
+        f"- Small-G slope, least squares through the origin: **D = {num(slope2, 4)} G** from the two "
+        f"smallest G, **D = {num(slope3, 4)} G** from the three smallest.",
+        "- Small-deformation theory (Barthes-Biesel & Rallison 1981): an initially spherical capsule in "
+        "simple shear takes D = 5/4 Ca (2 + nu_s) / (1 + nu_s), with Ca = mu gamma R / Gs, Gs the "
+        "small-strain shear modulus and nu_s the surface Poisson ratio of the membrane, whatever the "
+        "viscosity ratio. The neo-Hookean law has nu_s = 1/2 (area-dilatation modulus 3 Gs), "
+        "so D = 25/12 Ca, which is D = 25/4 mu gamma R / Es written with the surface "
+        "Young modulus Es = 3 Gs. Our kS is 3 Gs (CONVENTIONS, section 2), so Ca = 3 G and the "
+        "theory gives **D = 25/4 G = 6.25 G**. (D = 25/4 Ca with Ca = 3 G, i.e. 18.75 G, would mix "
+        "the two moduli.) The theory holds for D << 1; the membrane softens in the neo-Hookean law "
+        "at finite strain and the computed D falls below the line as G grows.",
+        f"- At G = 0.1 the literature of the paper's figure 12b (5120 triangles) lies in "
+        f"D = {lo:.2f} - {hi:.2f}; here D_steady = {num(d01)} with {n} triangles.",
+    ]
+    if t_end < 10:
+        lines.append(f"- Preview run (gamma t up to {fmt_g(t_end)}): the capsule has not reached its "
+                     "steady state, so the steady values are not comparable with the paper's.")
+    lines.append("")
+    return lines
+
+
+def section_b(results, runs, fig_dir, rel, t_end, none_results):
+    lines = ["## (b) All bending methods: deformation against time (figures 13 and 14)", ""]
+    lines.append("All methods on MT1 meshes, gamma t from 0 to " + fmt_g(t_end) + ". The grey dashed "
+                 "curve is the capsule without bending (kB_hat = 0) at the same G and resolution, when "
+                 "that run exists. The paper's figure 14 shows 5120 triangles, figure 13 the resolutions "
+                 "320, 1280, 5120 per method at G = 0.2.")
+    lines.append("")
+    triangles = sorted({r.triangles for r in runs})
+    for (G, kb) in PAIRS:
+        lines.append(f"### G = {fmt_g(G)}, kB_hat = {fmt_g(kb)}")
+        lines.append("")
+        for n in triangles:
+            fig, ax = plt.subplots(figsize=(7.0, 4.6))
+            ins = ax.inset_axes([0.5, 0.1, 0.46, 0.42]) if t_end > 5 else None
+            curves = []
+            ref = none_results.get((n, G))
+            if ref is not None and ref.ok and ref.series:
+                curves.append(("no bending", "none", ref.series))
+            for m in METHODS:
+                r = results.get(Run(m, n, G, kb, t_end))
+                if r is not None and r.ok and r.series:
+                    curves.append((m, m, r.series))
+            for label, key, s in curves:
+                ax.plot(s["gamma_t"], s["D"], label=label, **METHOD_STYLE[key])
+                if ins is not None:
+                    sel = s["gamma_t"] >= 5
+                    ins.plot(s["gamma_t"][sel], s["D"][sel], **METHOD_STYLE[key])
+            if ins is not None:
+                ins.set_xlim(5, t_end)
+                ins.tick_params(labelsize=7)
+                ins.grid(alpha=0.3)
+                ins.set_title(r"$\dot\gamma t \in [5, %g]$" % t_end, fontsize=8)
+            ax.set_xlabel(r"$\dot\gamma t$")
+            ax.set_ylabel("D")
+            ax.set_xlim(0, t_end)
+            ax.set_ylim(bottom=0)
+            ax.grid(alpha=0.3)
+            ax.legend(loc="upper left", fontsize=8, ncol=2)
+            ax.set_title(f"G = {fmt_g(G)}, kB_hat = {fmt_g(kb)}, {n} triangles")
+            fig.tight_layout()
+            name = f"fig14_G{fmt_g(G)}_kb{fmt_g(kb)}_{n}.png"
+            fig.savefig(fig_dir / name, dpi=110)
+            plt.close(fig)
+            lines += [f"![D against gamma t, G = {fmt_g(G)}, {n} triangles]({rel}/{name})", ""]
+
+        # Steady D per method and resolution, and the change from the coarsest to the finest mesh.
+        header = "| method | " + " | ".join(f"D_steady, {n}" for n in triangles)
+        if len(triangles) > 1:
+            header += f" | D_{triangles[0]} / D_{triangles[-1]} - 1"
+        header += " | theta_steady / pi, " + str(triangles[-1]) + " |"
+        lines += [f"Steady values over gamma t in {steady_label(t_end)}:", "", header,
+                  "|" + " --- |" * (header.count("|") - 1)]
+        for m in ["none"] + METHODS:
+            cells, ds = [], []
+            for n in triangles:
+                r = none_results.get((n, G)) if m == "none" else results.get(Run(m, n, G, kb, t_end))
+                if r is None:
+                    cells.append("")
+                    ds.append(None)
+                elif not r.ok:
+                    cells.append("failed")
+                    ds.append(None)
+                else:
+                    cells.append(num(r.summary["D_steady"]))
+                    ds.append(r.summary["D_steady"])
+            if all(c == "" for c in cells):
+                continue
+            row = f"| {'no bending' if m == 'none' else m} | " + " | ".join(cells)
+            if len(triangles) > 1:
+                a, b = ds[0], ds[-1]
+                row += " | " + (f"{100 * (a - b) / b:+.1f} %" if a is not None and b else "")
+            last = (none_results.get((triangles[-1], G)) if m == "none"
+                    else results.get(Run(m, triangles[-1], G, kb, t_end)))
+            th = last.summary["theta_steady"] if last is not None and last.ok else None
+            row += " | " + (num(th / math.pi) if th is not None else "") + " |"
+            lines.append(row)
+        lines.append("")
+    if t_end < 10:
+        lines += [f"Preview run (gamma t up to {fmt_g(t_end)}): the curves show only the start-up.", ""]
+    return lines
+
+
+def section_c(results, runs, t_end):
+    lines = ["## (c) Average time step (table 4) and run times", ""]
+    triangles = sorted({r.triangles for r in runs})
+    window = steady_label(t_end)
+    lines.append(f"Mean of the accepted Cash-Karp steps gamma dt whose end lies in gamma t in {window} "
+                 "(`mean_gamma_dt` of summary.json), relative tolerance 1e-7, absolute tolerance 1e-6 R, "
+                 "as in the paper. Paper: table 4 (BIM, MT1). The paper has no column for ED; "
+                 "'no bending' is its kB_hat = 0 column.")
+    if t_end < 10:
+        lines.append(f"Preview run: the window is gamma t in {window}, not [5, 10]; the steps early in a "
+                     "run need not match the steady ones, so the ratios are not those of the full study.")
+    lines.append("")
+    cols = ["none"] + METHODS
+    head = "| triangles | | " + " | ".join("no bending" if c == "none" else c for c in cols) + " |"
+    sep = "|" + " --- |" * (len(cols) + 2)
+    for (G, kb) in PAIRS:
+        lines += [f"### G = {fmt_g(G)}, kB_hat = {fmt_g(kb)} (paper: table 4{'a' if G < 0.1 else 'b'})",
+                  "", head, sep]
+        for n in triangles:
+            ours, paper, ratio = [], [], []
+            for c in cols:
+                r = results.get(Run(c, n, G, 0.0 if c == "none" else kb, t_end))
+                v = r.summary["mean_gamma_dt"] if r is not None and r.ok else None
+                p_text = PAPER_TABLE4[(G, kb)].get(n, {}).get(c)
+                p = float(p_text) if p_text is not None else None
+                ours.append("failed" if r is not None and not r.ok else num(v, 3))
+                paper.append(p_text if p_text is not None else "-")
+                ratio.append(f"{v / p:.2f}" if v is not None and p else "-")
+            lines.append(f"| {n} | ours | " + " | ".join(ours) + " |")
+            lines.append(f"| {n} | paper | " + " | ".join(paper) + " |")
+            lines.append(f"| {n} | ours / paper | " + " | ".join(ratio) + " |")
+        lines.append("")
+
+    lines += ["### Run times", "",
+              "Wall time of each `bendlab shear` run (one process, the machine shared with the "
+              "other runs of the study), accepted steps, velocity evaluations and the relative "
+              "volume change at the end.", "",
+              "| G | kB_hat | triangles | method | wall s | steps | rejected | velocity evaluations | "
+              "steps / s | volume change |",
+              "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+    for (G, kb) in PAIRS:
+        for n in triangles:
+            for c in cols:
+                r = results.get(Run(c, n, G, 0.0 if c == "none" else kb, t_end))
+                if r is None:
+                    continue
+                if not r.ok:
+                    lines.append(f"| {fmt_g(G)} | {fmt_g(kb)} | {n} | {c} | failed | | | | | |")
+                    continue
+                s = r.summary
+                w = s["wall_seconds"]
+                dv = (s["final_volume"] - s["initial_volume"]) / s["initial_volume"]
+                lines.append(f"| {fmt_g(G)} | {fmt_g(0.0 if c == 'none' else kb)} | {n} | "
+                             f"{'no bending' if c == 'none' else c} | {w:.0f} | {s['steps']} | "
+                             f"{s.get('rejected_steps', '')} | {s.get('velocity_evaluations', '')} | "
+                             f"{s['steps'] / w if w > 0 else math.nan:.3g} | {dv:.1e} |")
+    lines.append("")
+    return lines
+
+
+# ----------------------------------------------------------------------------- main
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--jobs", type=int, default=2, help="runs in parallel (default 2)")
+    ap.add_argument("--t-end", type=float, default=10.0,
+                    help="end of every run in gamma t (default 10; smaller for a quick preview)")
+    ap.add_argument("--only", choices=["a", "b", "c"], help="run only the runs of this part")
+    ap.add_argument("--bendlab", default="build/release/bendlab", help="the bendlab binary")
+    ap.add_argument("--work", default="results/shear_study", help="folder of the runs (the cache)")
+    ap.add_argument("--doc", default="docs/results/shear.md",
+                    help="the document to write; its figures go to a folder of the same name without .md")
+    ap.add_argument("--triangles", default="320,1280",
+                    help="resolutions of parts (b) and (c), comma separated (default 320,1280)")
+    ap.add_argument("--progress-every", type=float, default=60,
+                    help="seconds between progress lines of the running runs (default 60)")
+    ap.add_argument("--triangles-a", type=int, default=1280, help="resolution of part (a) (default 1280)")
+    args = ap.parse_args()
+    if args.jobs < 1:
+        ap.error("--jobs must be at least 1")
+    if not args.t_end > 0:
+        ap.error("--t-end must be positive")
+    try:
+        triangles = sorted({int(x) for x in args.triangles.split(",") if x.strip()})
+    except ValueError:
+        ap.error("--triangles takes numbers separated by commas, e.g. 320,1280")
+    if not triangles:
+        ap.error("--triangles is empty")
+
+    command = "/usr/bin/python3 scripts/shear_study.py" + "".join(" " + shlex.quote(a) for a in sys.argv[1:])
+    bendlab = Path(args.bendlab)
+    if not bendlab.is_absolute():
+        bendlab = (Path.cwd() / bendlab).resolve()
+    if not (bendlab.is_file() and os.access(bendlab, os.X_OK)):
+        sys.exit(f"error: no bendlab binary at '{args.bendlab}' (build it: cmake --preset release && "
+                 "cmake --build --preset release, or pass --bendlab PATH)")
+    work = Path(args.work).resolve()
+    doc = Path(args.doc).resolve()
+    fig_dir = doc.with_suffix("")
+    work.mkdir(parents=True, exist_ok=True)
+    fig_dir.mkdir(parents=True, exist_ok=True)
+
+    parts = [args.only] if args.only else ["a", "b", "c"]
+    runs_of = {p: part_runs(p, args.t_end, triangles, args.triangles_a) for p in "abc"}
+    todo = list(dict.fromkeys(r for p in parts for r in runs_of[p]))
+    # Long runs first, so that the parallel runs end close together: bending methods at the
+    # finest mesh, then by the paper's step size.
+    def cost(r):
+        dt = float(PAPER_TABLE4.get((r.G, r.kappa_b), {}).get(r.triangles, {}).get(r.method, "0.05"))
+        return -(r.triangles ** 1.5) * (4 if r.method == "D" else 1) / dt
+    todo.sort(key=cost)
+
+    say(f"shear study: {len(todo)} runs (parts {', '.join(parts)}), t_end {fmt_g(args.t_end)}, "
+        f"{args.jobs} in parallel, work folder {work}")
+    start = time.monotonic()
+    counter = Counter()
+    results = {}
+    signal.signal(signal.SIGTERM, _on_sigterm)
+    pool = ThreadPoolExecutor(max_workers=args.jobs)
+    try:
+        futures = {pool.submit(execute, r, work, bendlab, counter, len(todo)): r for r in todo}
+        pending = set(futures)
+        while pending:
+            done, pending = wait(pending, timeout=args.progress_every, return_when=FIRST_COMPLETED)
+            for f in done:
+                results[futures[f]] = f.result()
+            if not done:
+                report_running(work, time.monotonic() - start)
+    except KeyboardInterrupt:
+        stop_all()
+        pool.shutdown(wait=True, cancel_futures=True)
+        say("interrupted: finished runs are kept and running ones continue from their last checkpoint; "
+            "run the same command again to go on")
+        return 130
+    pool.shutdown(wait=True)
+    wall = time.monotonic() - start
+
+    # Parts not run now enter the document when all their runs are in the work folder.
+    shown = []
+    for p in "abc":
+        if p in parts:
+            shown.append(p)
+            continue
+        cached = {r: cached_result(r, work) for r in runs_of[p]}
+        if all(c is not None for c in cached.values()):
+            results.update({r: c for r, c in cached.items() if r not in results})
+            shown.append(p)
+    # The no-bending reference curves of part (b), when they exist.
+    none_results = {}
+    for n in triangles:
+        for (G, kb) in PAIRS:
+            r = Run("none", n, G, 0.0, args.t_end)
+            res = results.get(r) or cached_result(r, work)
+            if res is not None:
+                results.setdefault(r, res)
+                none_results[(n, G)] = res
+    load_series(results, work)
+
+    run_wall = sum(r.summary["wall_seconds"] for r in results.values() if r.ok)
+    failed = [r for r in results.values() if not r.ok]
+    rel = os.path.relpath(fig_dir, doc.parent)
+    cpu = ""
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    try:
+        commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
+                                text=True).stdout.strip()
+        if commit and subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], cwd=ROOT,
+                                     capture_output=True, text=True).stdout.strip():
+            commit += " with uncommitted changes"
+    except OSError:
+        commit = ""
+
+    lines = ["# Capsule in shear flow (paper section 4)", "",
+             "Generated by", "", f"    {command}", "",
+             f"- machine: {len(os.sched_getaffinity(0))} cores (nproc){', ' + cpu if cpu else ''}, {platform.system()} "
+             f"{platform.machine()}; {args.jobs} runs in parallel",
+             f"- gamma t from 0 to **{fmt_g(args.t_end)}** in every run"
+             + ("" if args.t_end >= 10 else " (a preview: the paper runs to 10)"),
+             f"- total wall time of this invocation: {wall:.0f} s ({wall / 60:.1f} min); the runs shown "
+             f"took {run_wall:.0f} s of run time together ({len([r for r in results.values() if r.cached])} "
+             "taken from the work folder)",
+             f"- parts shown: {', '.join(shown)}" + (f"; failed runs: {len(failed)}" if failed else ""),
+             f"- source commit: {commit}" if commit else None,
+             "",
+             "Every run is `bendlab shear --method M --mesh mt1:N --G G --kappa-b KB --t-end T --no-plot` "
+             "(boundary integral method, Cash-Karp with relative tolerance 1e-7 and absolute tolerance "
+             "1e-6 R). Units: G = mu gamma R / kS and kB_hat = kB / (R^2 kS) with the neo-Hookean "
+             "modulus kS of eq. (18), which is three times the shear modulus Gs: the capillary number "
+             "of the literature is Ca = mu gamma R / Gs = 3 G. D and theta come from the ellipsoid "
+             "with the inertia tensor of the enclosed volume. Steady values are time averages over "
+             f"gamma t in {steady_label(args.t_end)}.", ""]
+    lines = [l for l in lines if l is not None]
+    if "a" in shown:
+        lines += section_a(results, runs_of["a"], fig_dir, rel, args.t_end)
+    if "b" in shown:
+        lines += section_b(results, runs_of["b"], fig_dir, rel, args.t_end, none_results)
+    if "c" in shown:
+        lines += section_c(results, runs_of["c"], args.t_end)
+    for p in "abc":
+        if p not in shown:
+            lines += [f"## ({p})", "", f"Not shown: part ({p}) was not run with these options "
+                      f"(run `--only {p}` or without --only).", ""]
+    doc.parent.mkdir(parents=True, exist_ok=True)
+    tmp = doc.with_suffix(".md.tmp")
+    tmp.write_text("\n".join(lines).replace("\n\n\n", "\n\n"))
+    tmp.replace(doc)
+    say(f"wrote {doc} and {fig_dir}/ ({wall:.0f} s; {len(failed)} failed runs)")
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
