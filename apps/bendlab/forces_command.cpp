@@ -37,7 +37,7 @@ void run_forces(const ForcesArgs& a) {
   NodeErrors err;
   if (surface) {
     exact = surface->evaluate(mesh.positions(), a.kappa_b);
-    err = node_errors(exact, surface->maxima(a.kappa_b), r);
+    err = node_errors(exact, surface->maxima(a.kappa_b), r, a.kappa_b);
   }
   if (extension_of(a.out) == ".csv") {
     CsvTable t;

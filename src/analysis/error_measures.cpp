@@ -86,13 +86,20 @@ const Scalars& NodeErrors::operator[](Quantity q) const {
   throw Error("unknown quantity");
 }
 
-NodeErrors node_errors(const SurfaceFields& a, const SurfaceMaxima& m, const BendingResult& r) {
+NodeErrors node_errors(const SurfaceFields& a, const SurfaceMaxima& m, const BendingResult& r, double kappa_b) {
+  // A field that vanishes identically (Lap H and f on a sphere) has no maximum to divide by; its
+  // errors are then measured against the scale the field would have on a surface of the same
+  // size: max|H| / L^2 for Lap H and 2 |kB| max|H|^3 for f, with L = 1 / max|H|. A maximum below
+  // 1e-9 of that scale counts as vanishing.
+  const double lap_scale = m.H * m.H * m.H;
+  const double f_scale = 2 * std::abs(kappa_b) * lap_scale;
+  auto denominator = [](double maximum, double natural) { return maximum > 1e-9 * natural ? maximum : natural; };
   NodeErrors e;
   e.n = normal_errors(a.normal, r.normal);
   e.H = scalar_errors(a.H, r.H, m.H);
   e.K = scalar_errors(a.K, r.K, m.K);
-  e.lapH = scalar_errors(a.lapH, r.lapH, m.lapH);
-  e.f = vector_errors(a.f, r.force_density, m.f);
+  e.lapH = scalar_errors(a.lapH, r.lapH, denominator(m.lapH, lap_scale));
+  e.f = vector_errors(a.f, r.force_density, denominator(m.f, f_scale));
   return e;
 }
 

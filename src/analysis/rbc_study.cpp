@@ -139,7 +139,7 @@ RbcStudyResult run_rbc_study(const RbcStudyOptions& o) {
       const auto t0 = std::chrono::steady_clock::now();
       BendingResult result = method->compute(mesh.topology(), mesh.positions(), o.kappa_b);
       mr.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      NodeErrors errors = node_errors(analytic, out.maxima, result);
+      NodeErrors errors = node_errors(analytic, out.maxima, result, o.kappa_b);
       for (Quantity q : kAllQuantities) mr.errors.push_back(summarize(errors[q]));
       const ErrorSummary& ef = mr.errors[static_cast<std::size_t>(Quantity::F)];
       report(o, fmt::format("rbc: {} {} triangles, method {}: {:.3f} s, f error max {:.4g} avg {:.4g}", run.family,

@@ -116,3 +116,24 @@ TEST(ErrorMeasures, QuantityNames) {
   EXPECT_EQ(to_string(Quantity::LapH), "lapH");
   EXPECT_THROW(parse_quantity("laph"), Error);
 }
+
+TEST(ErrorMeasures, VanishingFieldsUseTheirNaturalScale) {
+  // On a sphere of radius 2, Lap H and f vanish: errors are relative to max|H|^3 = 1/8 and to
+  // 2 kB max|H|^3 = kB / 4.
+  auto sphere = make_sphere(2.0);
+  Points x(2, 3);
+  x << 2, 0, 0, 0, 0, -2;
+  const double kB = 3.0;
+  const SurfaceFields a = sphere->evaluate(x, kB);
+  BendingResult r;
+  r.normal = a.normal;
+  r.H = a.H;
+  r.K = a.K;
+  r.lapH = Scalars::Constant(2, 0.01);
+  r.force_density = Points::Zero(2, 3);
+  r.force_density(1, 2) = 0.3;
+  const NodeErrors e = node_errors(a, sphere->maxima(kB), r, kB);
+  EXPECT_NEAR(e.lapH[0], 0.01 / 0.125, 1e-12);
+  EXPECT_NEAR(e.f[0], 0.0, 1e-12);
+  EXPECT_NEAR(e.f[1], 0.3 / (kB / 4), 1e-12);
+}

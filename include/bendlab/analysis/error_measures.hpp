@@ -53,7 +53,10 @@ struct NodeErrors {
 /// eq. (17) for one method on one mesh: numerical.normal, H, K, lapH, force_density against the
 /// analytic fields at the same nodes, relative to the analytic surface maxima. Arrays of the wrong
 /// length throw bendlab::Error, except empty arrays, which count as not defined (all NaN).
+/// Where an analytic field vanishes identically (Lap H and f on a sphere: maximum below 1e-9 of
+/// the natural scale) the denominator is that natural scale instead: max|H|^3 for Lap H and
+/// 2 |kB| max|H|^3 for f (kappa_b is the kB the fields were computed with).
 NodeErrors node_errors(const SurfaceFields& analytic, const SurfaceMaxima& maxima,
-                       const BendingResult& numerical);
+                       const BendingResult& numerical, double kappa_b = 1.0);
 
 }  // namespace bendlab
