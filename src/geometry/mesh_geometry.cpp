@@ -33,11 +33,19 @@ MeshGeometry MeshGeometry::compute(const Topology& t, const Points& x) {
     double l2[3];  // l2[k] = squared length of the edge opposite corner k
     for (int k = 0; k < 3; ++k) {
       const Vec3 u = p[(k + 1) % 3] - p[k], w = p[(k + 2) % 3] - p[k];
-      const double d = u.dot(w);
-      g.corner_cot(f, k) = d / two_area;  // |u x w| = twice the area for every corner
-      g.corner_angle(f, k) = std::atan2(two_area, d);
+      g.corner_cot(f, k) = u.dot(w) / two_area;  // |u x w| = twice the area for every corner
       l2[k] = (p[(k + 2) % 3] - p[(k + 1) % 3]).squaredNorm();
     }
+    // Two angles from atan2 (accurate for any shape), the third from the angle sum: atan2 is the
+    // most expensive operation of the pass. The largest angle is the one derived, so its
+    // absolute rounding error (a few ulp of pi) stays small relative to it.
+    int big = 0;
+    for (int k = 1; k < 3; ++k)
+      if (g.corner_cot(f, k) < g.corner_cot(f, big)) big = k;
+    double sum = 0;
+    for (int k = 0; k < 3; ++k)
+      if (k != big) sum += g.corner_angle(f, k) = std::atan2(1.0, g.corner_cot(f, k));
+    g.corner_angle(f, big) = M_PI - sum;
     int obtuse = -1;
     for (int k = 0; k < 3; ++k)
       if (g.corner_cot(f, k) < 0) obtuse = k;

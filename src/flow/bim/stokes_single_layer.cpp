@@ -105,11 +105,11 @@ Vec3 polar_integral(const Vec3& x0, const Vec3& x1, const Vec3& x2, const Vec3& 
 }
 
 // Sum over all quadrature points y_k of the Stokeslet G(y_k, x) . f_k w_k for one target x.
-// Compiled twice (AVX2+FMA and baseline x86-64) and picked at run time, so the same binary runs
-// everywhere and uses 4-wide doubles where the processor has them. The file is built with
-// -fno-math-errno so that sqrt vectorises.
+// Compiled three times (AVX-512, AVX2+FMA and baseline x86-64) and picked at run time, so the
+// same binary runs everywhere and uses 8- or 4-wide doubles where the processor has them. The
+// file is built with -fno-math-errno (so that sqrt vectorises) and -ffp-contract=fast (FMA).
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
-__attribute__((target_clones("avx2,fma", "default")))
+__attribute__((target_clones("avx512f", "avx2,fma", "default")))
 #endif
 void regular_sum(double xi, double yi, double zi, const double* __restrict qx, const double* __restrict qy,
                  const double* __restrict qz, const double* __restrict fx, const double* __restrict fy,
