@@ -1,0 +1,120 @@
+// Bending force evaluation of every method on the red blood cell of the paper's section 3
+// (MT1 sphere meshes mapped onto the RBC), with 1 and 2 OpenMP threads.
+//   ./build/release/bench_bending
+//   ./build/release/bench_bending --benchmark_filter='BM_Compute/C/'
+//
+// Benchmarks (arguments: triangles, OpenMP threads):
+//   BM_Compute/<method>    BendingMethod::compute (every per-vertex quantity), methods A..E, ED
+//   BM_Forces/<method>     BendingMethod::forces (node forces only) where the method overrides it (A, B)
+//   BM_Compute/E_rings<R>  Method E with neighbourhoods of R = 2 and 3 rings, 5120 triangles
+// Counters: vertices_per_s (vertices / wall-clock second) and vertices_per_s_per_thread (the same
+// divided by the OpenMP threads). Times are wall-clock (UseRealTime), since the work runs on
+// OpenMP threads.
+//
+// Methods D and ED are O(N^2) (Belkin's heat kernel sums over every vertex pair): at 81920
+// triangles (40962 vertices) they run a single iteration.
+#include <benchmark/benchmark.h>
+#include <omp.h>
+
+#include <map>
+#include <memory>
+#include <string>
+
+#include "bendlab/bending/bending_method.hpp"
+#include "bendlab/mesh/generators.hpp"
+#include "bendlab/surfaces/analytic_surface.hpp"
+
+using namespace bendlab;
+
+namespace {
+
+// MT1 level for N_T = 20 * 4^level triangles.
+int mt1_level(int triangles) {
+  int level = 0;
+  for (int n = 20; n < triangles; n *= 4) ++level;
+  return level;
+}
+
+// The RBC mesh of a size, built once per program (generation is not what is measured).
+const TriMesh& rbc_mesh(int triangles) {
+  static std::map<int, std::unique_ptr<TriMesh>> cache;
+  auto& m = cache[triangles];
+  if (!m) {
+    const TriMesh sphere = sphere_mesh(MeshFamily::MT1, mt1_level(triangles));
+    m = std::make_unique<TriMesh>(sphere.with_positions(make_rbc()->map_from_unit_sphere(sphere.positions())));
+  }
+  return *m;
+}
+
+void set_counters(benchmark::State& state, const TriMesh& mesh, int threads) {
+  state.counters["triangles"] = mesh.num_faces();
+  state.counters["vertices"] = mesh.num_vertices();
+  state.counters["threads"] = threads;
+  state.counters["vertices_per_s"] =
+      benchmark::Counter(mesh.num_vertices(), benchmark::Counter::kIsIterationInvariantRate);
+  state.counters["vertices_per_s_per_thread"] =
+      benchmark::Counter(static_cast<double>(mesh.num_vertices()) / threads,
+                         benchmark::Counter::kIsIterationInvariantRate);
+}
+
+void BM_Compute(benchmark::State& state, const std::string& method, const MethodOptions& options) {
+  const TriMesh& mesh = rbc_mesh(static_cast<int>(state.range(0)));
+  const int threads = static_cast<int>(state.range(1));
+  omp_set_num_threads(threads);
+  const auto m = make_bending_method(method, options);
+  for (auto _ : state) {
+    BendingResult r = m->compute(mesh.topology(), mesh.positions(), 1.0);
+    benchmark::DoNotOptimize(r.force.data());
+    benchmark::ClobberMemory();
+  }
+  set_counters(state, mesh, threads);
+}
+
+void BM_Forces(benchmark::State& state, const std::string& method) {
+  const TriMesh& mesh = rbc_mesh(static_cast<int>(state.range(0)));
+  const int threads = static_cast<int>(state.range(1));
+  omp_set_num_threads(threads);
+  const auto m = make_bending_method(method);
+  Points force(mesh.num_vertices(), 3);
+  for (auto _ : state) {
+    m->forces(mesh.topology(), mesh.positions(), 1.0, force);
+    benchmark::DoNotOptimize(force.data());
+    benchmark::ClobberMemory();
+  }
+  set_counters(state, mesh, threads);
+}
+
+void register_all() {
+  const char* methods[] = {"A", "B", "C", "D", "E", "ED"};
+  for (const std::string method : methods) {
+    const bool quadratic = method == "D" || method == "ED";
+    for (const int triangles : {5120, 81920}) {
+      for (const int threads : {1, 2}) {
+        auto* b = benchmark::RegisterBenchmark(("BM_Compute/" + method).c_str(), BM_Compute, method, MethodOptions{});
+        b->Args({triangles, threads})->ArgNames({"triangles", "threads"})->UseRealTime()->Unit(benchmark::kMillisecond);
+        if (quadratic && triangles > 5120) b->Iterations(1);
+      }
+    }
+  }
+  for (const std::string method : {"A", "B"}) {
+    auto* b = benchmark::RegisterBenchmark(("BM_Forces/" + method).c_str(), BM_Forces, method);
+    b->ArgsProduct({{5120, 81920}, {1, 2}})->ArgNames({"triangles", "threads"})->UseRealTime()->Unit(benchmark::kMillisecond);
+  }
+  for (const int rings : {2, 3}) {
+    const std::string name = "BM_Compute/E_rings" + std::to_string(rings);
+    auto* b = benchmark::RegisterBenchmark(name.c_str(), BM_Compute, std::string("E"),
+                                           MethodOptions{{"rings", std::to_string(rings)}});
+    b->ArgsProduct({{5120}, {1, 2}})->ArgNames({"triangles", "threads"})->UseRealTime()->Unit(benchmark::kMillisecond);
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  register_all();
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

@@ -1,0 +1,378 @@
+#!/usr/bin/python3
+"""Writes docs/benchmarks.md from the JSON reports of scripts/run_benchmarks.sh.
+
+    /usr/bin/python3 scripts/make_benchmarks_doc.py --results results/bench --out docs/benchmarks.md
+
+Reads <results>/machine.txt and <results>/bench_{geometry,bending,bim}.json (Google Benchmark's
+--benchmark_format=json). Standard library only.
+"""
+import argparse
+import json
+import os
+import sys
+
+# Above this one-minute load average (on the 2-core reference machine) the timings are disturbed
+# by other work, the two-thread ones most.
+BUSY_LOAD = 2.5
+
+# The targets of the performance issue.
+BIM_TARGET_S = 0.1            # s per single-layer evaluation, 5120 triangles, 2 threads
+CB_TARGET_VPS = 3.0e6         # vertices per second per core, Methods B and C, 81920 triangles
+E_TARGET_VPS = 0.5e6          # vertices per second per core, Method E, 81920 triangles
+# Topology + geometry at 81920 triangles: the time is reported; set a limit in seconds here to
+# have it judged.
+GEOMETRY_TARGET_S = None
+
+# Approximate operations per target-source pair of the Stokeslet kernel (differences, |r|^2,
+# 1/|r| counted as two, f.r / r^3, three accumulations), to set its speed against the
+# multiply-add peak.
+STOKESLET_FLOPS_PER_PAIR = 30
+
+
+def parse_name(name):
+    """'BM_Compute/A/triangles:5120/threads:1/real_time' -> ('BM_Compute', 'A', {'triangles': 5120, ...})."""
+    parts = [p for p in name.split("/") if p and p != "real_time"]
+    family, variant, args = parts[0], [], {}
+    for p in parts[1:]:
+        if ":" in p:
+            k, v = p.split(":", 1)
+            try:
+                args[k] = int(v)
+            except ValueError:
+                args[k] = v
+        else:
+            variant.append(p)
+    return family, "/".join(variant), args
+
+
+def seconds(b):
+    scale = {"ns": 1e-9, "us": 1e-6, "ms": 1e-3, "s": 1.0}[b.get("time_unit", "ns")]
+    return b["real_time"] * scale
+
+
+def cpu_seconds(b):
+    scale = {"ns": 1e-9, "us": 1e-6, "ms": 1e-3, "s": 1.0}[b.get("time_unit", "ns")]
+    return b["cpu_time"] * scale
+
+
+def load_report(path):
+    if not os.path.exists(path):
+        return None
+    with open(path) as f:
+        report = json.load(f)
+    rows = []
+    for b in report.get("benchmarks", []):
+        if b.get("run_type", "iteration") != "iteration":
+            continue
+        family, variant, args = parse_name(b["name"])
+        rows.append({"family": family, "variant": variant, "args": args, "b": b,
+                     "error": b.get("error_message") if b.get("error_occurred") else None})
+    return {"context": report.get("context", {}), "rows": rows}
+
+
+def read_machine(path):
+    info = {}
+    if os.path.exists(path):
+        with open(path) as f:
+            for line in f:
+                if ":" in line:
+                    k, v = line.split(":", 1)
+                    info[k.strip()] = v.strip()
+    return info
+
+
+def si(x, unit=""):
+    if x is None:
+        return "-"
+    for factor, prefix in ((1e9, "G"), (1e6, "M"), (1e3, "k")):
+        if abs(x) >= factor:
+            return f"{x / factor:.3g} {prefix}{unit}".rstrip()
+    return f"{x:.3g} {unit}".rstrip()
+
+
+def ms(s):
+    if s is None:
+        return "-"
+    return f"{s * 1e3:.4g}"
+
+
+def find(report, family, variant=None, **args):
+    if report is None:
+        return None
+    for r in report["rows"]:
+        if r["family"] != family or (variant is not None and r["variant"] != variant):
+            continue
+        if all(r["args"].get(k) == v for k, v in args.items()):
+            return r
+    return None
+
+
+def counter(row, name):
+    if row is None or row["error"]:
+        return None
+    return row["b"].get(name)
+
+
+def verdict(ok):
+    return "met" if ok else "**not met**"
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--results", default="results/bench")
+    ap.add_argument("--out", default="docs/benchmarks.md")
+    a = ap.parse_args()
+
+    machine = read_machine(os.path.join(a.results, "machine.txt"))
+    geo = load_report(os.path.join(a.results, "bench_geometry.json"))
+    bend = load_report(os.path.join(a.results, "bench_bending.json"))
+    bim = load_report(os.path.join(a.results, "bench_bim.json"))
+    if not (geo or bend or bim):
+        sys.exit(f"make_benchmarks_doc: no bench_*.json in {a.results}")
+
+    def load1(s):
+        try:
+            return float(s.split()[0])
+        except (AttributeError, IndexError, ValueError):
+            return None
+
+    load_start, load_end = load1(machine.get("load_start")), load1(machine.get("load_end"))
+    busy = any(x is not None and x > BUSY_LOAD for x in (load_start, load_end))
+    out = []
+    w = out.append
+
+    w("# Benchmarks")
+    w("")
+    w("Measured speed of the mesh, bending and boundary-integral code, written by")
+    w("`scripts/make_benchmarks_doc.py` from the JSON reports of the command")
+    w("")
+    w(f"    {machine.get('command', 'bash scripts/run_benchmarks.sh')}")
+    w("")
+    w("which builds the release preset and runs `bench_geometry`, `bench_bending` and `bench_bim`")
+    w("(sources in `bench/`). Times are wall-clock; \"per thread\" divides a rate by the OpenMP threads")
+    w("(`omp_set_num_threads` inside each benchmark), so with one thread it is the rate of one core.")
+    w("")
+    w("## Machine")
+    w("")
+    w("| | |")
+    w("| --- | --- |")
+    w(f"| date | {machine.get('date', '-')} |")
+    w(f"| commit | {machine.get('commit', '-')} |")
+    w(f"| CPU | {machine.get('cpu_model', '-')} |")
+    w(f"| cores (`nproc`) | {machine.get('nproc', '-')} |")
+    w(f"| compiler | {machine.get('compiler', '-')} |")
+    native = machine.get("native", "OFF") or "OFF"
+    w(f"| `BENDLAB_NATIVE` (`-march=native`) | {native} |")
+    w(f"| load average (1, 5, 15 min) at the start | {machine.get('load_start', '-')} |")
+    w(f"| load average at the end | {machine.get('load_end', '-')} |")
+    w("")
+    if busy:
+        w(f"**The machine was busy during this run** (one-minute load average above {BUSY_LOAD} on")
+        w(f"{machine.get('nproc', '?')} cores): other processes competed for the cores, so every figure")
+        w("below is lower than on a quiet machine, the two-thread ones much lower (OpenMP threads wait")
+        w("for each other when one of them is descheduled). Run the command again on a quiet machine")
+        w("before drawing conclusions from the two-thread columns.")
+        w("")
+    if native.upper() in ("OFF", "", "FALSE", "0"):
+        w("The release preset compiles for the baseline x86-64 instruction set (SSE2, two doubles per")
+        w("vector instruction) whatever the processor supports, except the boundary-integral kernel, which")
+        w("is compiled for AVX-512, AVX2+FMA and baseline and picks the best at run time;")
+        w("`-DBENDLAB_NATIVE=ON` compiles everything for the build machine's own instruction set.")
+        w("")
+    ctx = next((r["context"] for r in (geo, bend, bim) if r), {})
+    if ctx.get("library_build_type") == "debug":
+        w("Google Benchmark prints a warning that its library was built as DEBUG: that is the Debian")
+        w("package's own build of the timing harness, not of the code measured.")
+        w("")
+
+    # ---------------------------------------------------------------- targets
+    w("## Targets")
+    w("")
+    w("| target | measured (wall clock) | ratio (measured / target, > 1 is better) | verdict | on the thread's CPU time |")
+    w("| --- | --- | --- | --- | --- |")
+    tg = find(geo, "BM_TopologyPlusGeometry", triangles=81920) or find(geo, "BM_TopologyPlusGeometry")
+    if tg and not tg["error"]:
+        t = seconds(tg["b"])
+        if GEOMETRY_TARGET_S:
+            w(f"| topology + geometry, 81920 triangles, at most {GEOMETRY_TARGET_S * 1e3:g} ms | {ms(t)} ms | "
+              f"{GEOMETRY_TARGET_S / t:.2f} | {verdict(t <= GEOMETRY_TARGET_S)} | {ms(cpu_seconds(tg['b']))} ms |")
+        else:
+            w(f"| topology + geometry, 81920 triangles (no limit set in `make_benchmarks_doc.py`) | {ms(t)} ms "
+              f"({si(40962 / t)} vertices/s) | - | not judged | {ms(cpu_seconds(tg['b']))} ms |")
+    else:
+        w("| topology + geometry, 81920 triangles | not measured | - | **not met** | - |")
+
+    def per_core_target(label, family, variant, target):
+        r = find(bend, family, variant, triangles=81920, threads=1)
+        v = counter(r, "vertices_per_s_per_thread")
+        r2 = find(bend, family, variant, triangles=81920, threads=2)
+        v2 = counter(r2, "vertices_per_s_per_thread")
+        extra = f" (2 threads: {si(v2)}/s per thread)" if v2 else ""
+        if v is None:
+            w(f"| {label}, 81920 triangles, at least {si(target)} vertices/s per core | not measured | - | **not met** | - |")
+        else:
+            vc = r["b"]["vertices"] / cpu_seconds(r["b"])
+            w(f"| {label}, 81920 triangles, at least {si(target)} vertices/s per core | {si(v)}/s on 1 thread{extra} | "
+              f"{v / target:.2f} | {verdict(v >= target)} | {si(vc)}/s ({vc / target:.2f}) |")
+
+    per_core_target("Method C (`compute`)", "BM_Compute", "C", CB_TARGET_VPS)
+    per_core_target("Method B (`forces`, what a flow solver calls)", "BM_Forces", "B", CB_TARGET_VPS)
+    per_core_target("Method B (`compute`, every quantity)", "BM_Compute", "B", CB_TARGET_VPS)
+    per_core_target("Method E (`compute`, 1 ring)", "BM_Compute", "E", E_TARGET_VPS)
+    r = find(bim, "BM_SingleLayer", triangles=5120, threads=2)
+    s = counter(r, "s_per_eval")
+    if s is None:
+        w(f"| single layer, 5120 triangles, 2 threads, at most {BIM_TARGET_S} s per evaluation | not measured | - | **not met** | - |")
+    else:
+        w(f"| single layer, 5120 triangles, 2 threads, at most {BIM_TARGET_S} s per evaluation | {s:.4g} s | "
+          f"{BIM_TARGET_S / s:.2f} | {verdict(s <= BIM_TARGET_S)} | - |")
+    w("")
+    w("The per-core targets are judged on the one-thread run (one core's rate); the two-thread")
+    w("rate per thread is shown beside it. The last column divides by the CPU time the benchmark's")
+    w("thread actually ran instead of the wall clock: on a busy machine, where the thread waits for a")
+    w("core, it estimates what a quiet machine gives (it is not the verdict).")
+    if busy:
+        w("On this busy machine a target that is not met may be met on a quiet one, and the margin of")
+        w("one that is met is understated.")
+    w("")
+
+    # ---------------------------------------------------------------- geometry
+    if geo:
+        w("## Topology and geometry (`bench_geometry`)")
+        w("")
+        w("MT1 unit spheres; `BM_TopologyBuild`: validated connectivity; `BM_MeshGeometry`: every")
+        w("quantity of `MeshGeometry`; `BM_TopologyPlusGeometry`: a `TriMesh` from positions and faces,")
+        w("then its geometry. OpenMP's default thread count (every core), since `bench_geometry` does")
+        w("not set one; on a busy machine the parallel passes of `MeshGeometry` wait for each other, which")
+        w("is what the small meshes' times show.")
+        w("")
+        w("| benchmark | triangles | time (ms) | vertices/s |")
+        w("| --- | --- | --- | --- |")
+        for r in geo["rows"]:
+            b = r["b"]
+            tri = int(b.get("triangles", 0))
+            if r["error"]:
+                w(f"| {r['family']} | {tri} | error: {r['error']} | - |")
+                continue
+            nv = tri // 2 + 2
+            vps = b.get("vertices_per_s") or nv / seconds(b)
+            w(f"| {r['family']} | {tri} | {ms(seconds(b))} | {si(vps)} |")
+        w("")
+
+    # ---------------------------------------------------------------- bending
+    if bend:
+        w("## Bending forces (`bench_bending`)")
+        w("")
+        w("MT1 meshes mapped onto the red blood cell of section 3; `compute` returns every per-vertex")
+        w("quantity, `forces` only the node forces (A and B implement it separately; for the other")
+        w("methods it calls `compute`). Methods D and ED sum over every vertex pair (O(N^2)) and run a")
+        w("single iteration at 81920 triangles. `E_rings2`, `E_rings3`: Method E fitted on 2 and 3 rings.")
+        w("")
+        w("| method | call | triangles | threads | time (ms) | CPU time of the main thread (ms) | vertices/s | vertices/s per thread | iterations |")
+        w("| --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+        for r in bend["rows"]:
+            b = r["b"]
+            call = "forces" if r["family"] == "BM_Forces" else "compute"
+            a_ = r["args"]
+            if r["error"]:
+                w(f"| {r['variant']} | {call} | {a_.get('triangles')} | {a_.get('threads')} | error: {r['error']} | - | - | - | - |")
+                continue
+            w(f"| {r['variant']} | {call} | {a_.get('triangles')} | {a_.get('threads')} | {ms(seconds(b))} | {ms(cpu_seconds(b))} | "
+              f"{si(b.get('vertices_per_s'))} | {si(b.get('vertices_per_s_per_thread'))} | {b.get('iterations')} |")
+        w("")
+
+    # ---------------------------------------------------------------- BIM
+    if bim:
+        w("## Boundary integral (`bench_bim`)")
+        w("")
+        w("One `StokesSingleLayer::velocity` on an MT1 unit sphere with the force density f = n z;")
+        w("pairs = N_vertices x N_triangles x 7 (the 7-point rule over every triangle for every node).")
+        w("`BM_StokesletReference` is the regular part alone on contiguous arrays of the same points, with")
+        w("the same arithmetic and nothing else, for three instruction sets: `baseline` (what the build")
+        w("targets by default), `avx2` (4 doubles a vector, FMA) and `avx512` (8 doubles); the fastest is")
+        w("what this machine does with the kernel's shape. Efficiency = single-layer pairs/s / the fastest")
+        w("reference's pairs/s at the same size and threads (the reference in brackets); the last column")
+        w("sets it against the `avx2` reference alone, the widest instruction set the solver's kernel is")
+        w("compiled for (`target_clones`).")
+        w("")
+        w("| benchmark | triangles | threads | s per evaluation | pairs/s | pairs/s per thread | efficiency | vs avx2 |")
+        w("| --- | --- | --- | --- | --- | --- | --- | --- |")
+
+        def best_reference(tri, thr):
+            best = None
+            for r in bim["rows"]:
+                if (r["family"] == "BM_StokesletReference" and not r["error"] and r["args"].get("triangles") == tri
+                        and r["args"].get("threads") == thr):
+                    if best is None or r["b"]["pairs_per_s"] > best["b"]["pairs_per_s"]:
+                        best = r
+            return best
+
+        skipped = set()
+        for r in bim["rows"]:
+            if r["family"] == "BM_MultiplyAddPeak":
+                continue
+            b, a_ = r["b"], r["args"]
+            label = r["family"] + (f" ({r['variant']})" if r["variant"] else "")
+            if r["error"]:
+                skipped.add(f"{label}: {r['error']}")
+                continue
+            eff, eff2 = "-", "-"
+            if r["family"] == "BM_SingleLayer":
+                ref = best_reference(a_.get("triangles"), a_.get("threads"))
+                if ref:
+                    eff = f"{b['pairs_per_s'] / ref['b']['pairs_per_s']:.0%} ({ref['variant']})"
+                ref2 = counter(find(bim, "BM_StokesletReference", "avx2", triangles=a_.get("triangles"),
+                                    threads=a_.get("threads")), "pairs_per_s")
+                if ref2:
+                    eff2 = f"{b['pairs_per_s'] / ref2:.0%}"
+            w(f"| {label} | {a_.get('triangles')} | {a_.get('threads')} | {seconds(b):.4g} | "
+              f"{si(b.get('pairs_per_s'))} | {si(b.get('pairs_per_s_per_thread'))} | {eff} | {eff2} |")
+        w("")
+        peaks = [r for r in bim["rows"] if r["family"] == "BM_MultiplyAddPeak"]
+        for r in peaks:
+            if r["error"]:
+                skipped.add(f"BM_MultiplyAddPeak ({r['variant']}): {r['error']}")
+        if skipped:
+            w("Not run: " + "; ".join(sorted(skipped)) + ".")
+            w("")
+        peaks = [r for r in peaks if not r["error"]]
+        if peaks:
+            w("Arithmetic peak (`BM_MultiplyAddPeak`: independent multiply-add chains in registers):")
+            w("")
+            w("| instruction set | threads | flops/s | flops/s per thread |")
+            w("| --- | --- | --- | --- |")
+            for r in peaks:
+                w(f"| {r['variant']} | {r['args'].get('threads')} | {si(r['b'].get('flops_per_s'))} | "
+                  f"{si(r['b'].get('flops_per_s_per_thread'))} |")
+            w("")
+            lines = []
+            for r in peaks:
+                if r["args"].get("threads") != 1:
+                    continue
+                ref = counter(find(bim, "BM_StokesletReference", r["variant"], triangles=5120, threads=1), "pairs_per_s")
+                if ref:
+                    ops = ref * STOKESLET_FLOPS_PER_PAIR
+                    lines.append(f"{r['variant']} {si(ops)} operations/s, {ops / r['b']['flops_per_s']:.0%} of its peak")
+            if lines:
+                w(f"Counting about {STOKESLET_FLOPS_PER_PAIR} operations per pair (the square root and the division")
+                w("as one each), the one-thread reference kernels at 5120 triangles do: " + "; ".join(lines) + ".")
+                w("A square root and a division each occupy the divider for several multiply-add slots, so the")
+                w("kernel is bound by them and stays well below the multiply-add peak even when written as")
+                w("tightly as the reference.")
+                w("")
+
+    w("## Running one benchmark")
+    w("")
+    w("    cmake --preset release && cmake --build --preset release")
+    w("    ./build/release/bench_bending --benchmark_filter='BM_Compute/C/'")
+    w("    ./build/release/bench_bim --benchmark_filter='triangles:5120'")
+    w("")
+    os.makedirs(os.path.dirname(a.out) or ".", exist_ok=True)
+    tmp = a.out + ".tmp"
+    with open(tmp, "w") as f:
+        f.write("\n".join(out))
+    os.replace(tmp, a.out)
+
+
+if __name__ == "__main__":
+    main()
