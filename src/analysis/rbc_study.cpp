@@ -165,15 +165,19 @@ RbcStudyResult run_rbc_study(const RbcStudyOptions& o) {
 namespace {
 std::string slope_text(double s) { return std::isfinite(s) ? fmt::format("{:+.1f}", s) : "n/a"; }
 const std::vector<std::string> kTableQuantities = {"K", "H", "lapH", "f", "n"};
-}  // namespace
-
-std::string table2_markdown(const std::vector<RateFit>& fits, const std::string& family, const std::string& measure,
-                            const std::vector<std::string>& methods) {
+// "| quantity | A | B | ... |" and its separator line.
+std::string table_header(const std::vector<std::string>& methods) {
   std::string md = "| quantity |";
   for (const auto& m : methods) md += " " + m + " |";
   md += "\n|---|";
   for (std::size_t i = 0; i < methods.size(); ++i) md += "---|";
-  md += "\n";
+  return md + "\n";
+}
+}  // namespace
+
+std::string table2_markdown(const std::vector<RateFit>& fits, const std::string& family, const std::string& measure,
+                            const std::vector<std::string>& methods) {
+  std::string md = table_header(methods);
   for (const std::string& q : kTableQuantities) {
     md += "| " + q + " |";
     for (const std::string& m : methods) {
@@ -191,11 +195,7 @@ std::string table2_markdown(const std::vector<RateFit>& fits, const std::string&
 }
 
 std::string table3_markdown(const std::vector<InhomogeneityCheck>& checks, const std::vector<std::string>& methods) {
-  std::string md = "| quantity |";
-  for (const auto& m : methods) md += " " + m + " |";
-  md += "\n|---|";
-  for (std::size_t i = 0; i < methods.size(); ++i) md += "---|";
-  md += "\n";
+  std::string md = table_header(methods);
   for (const std::string& q : kTableQuantities) {
     md += "| " + q + " |";
     for (const std::string& m : methods) {
