@@ -11,6 +11,7 @@
 #include "bendlab/geometry/measures.hpp"
 #include "bendlab/mesh/generators.hpp"
 #include "bendlab/surfaces/analytic_surface.hpp"
+#include "bending/rbc_test_support.hpp"
 
 using namespace bendlab;
 
@@ -249,29 +250,7 @@ TEST(BelkinMethod, ScalingAndRotation) {
 }
 
 TEST(BelkinMethod, RedBloodCell5120) {
-  const TriMesh m = sphere_mesh(MeshFamily::MT1, 4);
-  ASSERT_EQ(m.num_faces(), 5120);
-  const auto rbc = make_rbc();
-  const Points x = rbc->map_from_unit_sphere(m.positions());
-  const SurfaceFields exact = rbc->evaluate(x);
-  const SurfaceMaxima mx = rbc->maxima();
-  const BendingResult r = BelkinMethod().compute(m.topology(), x, 1.0);
-  const int n = m.num_vertices();
-  int considered = 0, agree = 0;
-  double eh_mean = 0, eh_max = 0, ef_mean = 0, ef_max = 0;
-  for (int i = 0; i < n; ++i) {
-    const double eh = std::abs(exact.H[i] - r.H[i]) / mx.H;
-    const double ef = (exact.f.row(i) - r.force_density.row(i)).norm() / mx.f;
-    eh_mean += eh / n, ef_mean += ef / n;
-    eh_max = std::max(eh_max, eh), ef_max = std::max(ef_max, ef);
-    if (std::abs(exact.f_normal[i]) > 0.1 * mx.f) {
-      ++considered;
-      if (r.force_density.row(i).dot(exact.normal.row(i)) * exact.f_normal[i] > 0) ++agree;
-    }
-  }
-  const double fraction = double(agree) / considered;
-  std::printf("[Belkin RBC 5120] eps_H mean %.4f max %.4f | eps_f mean %.4f max %.4f | sign agrees at %d/%d = %.3f\n",
-              eh_mean, eh_max, ef_mean, ef_max, agree, considered, fraction);
-  EXPECT_LT(eh_mean, 0.05);
-  EXPECT_GT(fraction, 0.9);
+  const auto a = test_support::rbc_agreement_5120(BelkinMethod(), "Belkin");
+  EXPECT_LT(a.eh_mean, 0.05);
+  EXPECT_GT(a.fraction(), 0.9);
 }
