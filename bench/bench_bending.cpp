@@ -28,19 +28,12 @@ using namespace bendlab;
 
 namespace {
 
-// MT1 level for N_T = 20 * 4^level triangles.
-int mt1_level(int triangles) {
-  int level = 0;
-  for (int n = 20; n < triangles; n *= 4) ++level;
-  return level;
-}
-
 // The RBC mesh of a size, built once per program (generation is not what is measured).
 const TriMesh& rbc_mesh(int triangles) {
   static std::map<int, std::unique_ptr<TriMesh>> cache;
   auto& m = cache[triangles];
   if (!m) {
-    const TriMesh sphere = sphere_mesh(MeshFamily::MT1, mt1_level(triangles));
+    const TriMesh sphere = sphere_mesh(MeshFamily::MT1, level_with_triangles(MeshFamily::MT1, triangles));
     m = std::make_unique<TriMesh>(sphere.with_positions(make_rbc()->map_from_unit_sphere(sphere.positions())));
   }
   return *m;

@@ -41,16 +41,10 @@ using namespace bendlab;
 
 namespace {
 
-int mt1_level(int triangles) {
-  int level = 0;
-  for (int n = 20; n < triangles; n *= 4) ++level;
-  return level;
-}
-
 const TriMesh& unit_sphere(int triangles) {
   static std::map<int, std::unique_ptr<TriMesh>> cache;
   auto& m = cache[triangles];
-  if (!m) m = std::make_unique<TriMesh>(sphere_mesh(MeshFamily::MT1, mt1_level(triangles)));
+  if (!m) m = std::make_unique<TriMesh>(sphere_mesh(MeshFamily::MT1, level_with_triangles(MeshFamily::MT1, triangles)));
   return *m;
 }
 

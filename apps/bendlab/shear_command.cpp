@@ -43,10 +43,11 @@ TriMesh capsule_mesh(const std::string& spec) {
   if (std::regex_match(spec, m, std::regex(R"((mt1|mt2|octa):(\d+))"))) {
     const MeshFamily family = parse_mesh_family(m[1]);
     const long triangles = std::stol(m[2]);
-    const long base = family == MeshFamily::Octa ? 8 : 20;
-    for (int level = 0; level <= 7; ++level)
-      if (base << (2 * level) == triangles) return sphere_mesh(family, level);
-    throw Error(fmt::format("--mesh {}: {} has no level with {} triangles ({} * 4^k)", spec, m[1].str(), triangles, base));
+    const int level = level_with_triangles(family, triangles);
+    if (level < 0 || level > 7)
+      throw Error(fmt::format("--mesh {}: {} has no level with {} triangles (up to 7 steps of 4x refinement)", spec,
+                              m[1].str(), triangles));
+    return sphere_mesh(family, level);
   }
   if (std::regex_match(spec, m, std::regex(R"(inh:(mt1|mt2))"))) return sphere_mesh(parse_mesh_family(m[1]), 2, 3);
   if (!fs::exists(spec))

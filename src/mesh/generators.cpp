@@ -267,4 +267,11 @@ TriMesh sphere_mesh(MeshFamily family, int level, int rivara_passes) {
   return m;
 }
 
+int level_with_triangles(MeshFamily family, long triangles) {
+  const long base = family == MeshFamily::Octa ? 8 : 20;
+  for (int level = 0; level <= 12; ++level)
+    if (base << (2 * level) == triangles) return level;
+  return -1;
+}
+
 }  // namespace bendlab

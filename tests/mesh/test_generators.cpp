@@ -257,3 +257,12 @@ TEST(GeneratorRivara, ThreePassesFromThe320Meshes) {
     ::testing::Test::RecordProperty(to_string(fam) + "_rivara3_triangles", m.num_faces());
   }
 }
+
+TEST(GeneratorLevels, LevelWithTrianglesInvertsTheCount) {
+  for (int k = 0; k <= 6; ++k) {
+    EXPECT_EQ(level_with_triangles(MeshFamily::MT1, 20L << (2 * k)), k);
+    EXPECT_EQ(level_with_triangles(MeshFamily::Octa, 8L << (2 * k)), k);
+  }
+  EXPECT_EQ(level_with_triangles(MeshFamily::MT2, 1000), -1);
+  EXPECT_EQ(level_with_triangles(MeshFamily::Octa, 320), -1);
+}

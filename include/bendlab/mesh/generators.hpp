@@ -43,6 +43,10 @@ TriMesh refine_midpoint(const TriMesh& mesh, bool project_to_unit_sphere = true)
 /// 3848 (CONVENTIONS.md section 4).
 TriMesh rivara_pass(const TriMesh& mesh, bool project_to_unit_sphere = true);
 
+/// The refinement level k whose mesh of `family` has exactly `triangles` triangles
+/// (20 * 4^k or 8 * 4^k), or -1 if there is none.
+int level_with_triangles(MeshFamily family, long triangles);
+
 /// The unit sphere of a family at refinement level k, then `rivara_passes` Rivara passes.
 TriMesh sphere_mesh(MeshFamily family, int level, int rivara_passes = 0);
 
