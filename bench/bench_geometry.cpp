@@ -1,5 +1,5 @@
-// Topology and geometry of the paper's meshes: build the validated connectivity and compute
-// every per-face and per-vertex quantity of MeshGeometry.
+// Topology and geometry of the paper's meshes: generate them, build the validated connectivity and
+// compute every per-face and per-vertex quantity of MeshGeometry.
 //   ./build/release/bench_geometry
 #include <benchmark/benchmark.h>
 
@@ -18,6 +18,18 @@ static void BM_TopologyBuild(benchmark::State& state) {
   state.counters["vertices_per_s"] = benchmark::Counter(mesh.num_vertices(), benchmark::Counter::kIsIterationInvariantRate);
 }
 BENCHMARK(BM_TopologyBuild)->Arg(3)->Arg(6)->Unit(benchmark::kMillisecond);
+
+// The whole MT1 generator (icosahedron, Loop-rule refinement, projection, validated TriMesh).
+static void BM_SphereMeshBuild(benchmark::State& state) {
+  int faces = 0;
+  for (auto _ : state) {
+    const TriMesh m = sphere_mesh(MeshFamily::MT1, static_cast<int>(state.range(0)));
+    faces = m.num_faces();
+    benchmark::DoNotOptimize(m.positions().data());
+  }
+  state.counters["triangles"] = faces;
+}
+BENCHMARK(BM_SphereMeshBuild)->Arg(6)->Unit(benchmark::kMillisecond);
 
 static void BM_MeshGeometry(benchmark::State& state) {
   const TriMesh mesh = sphere_mesh(MeshFamily::MT1, static_cast<int>(state.range(0)));

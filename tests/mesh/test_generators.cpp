@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <array>
-#include <chrono>
 #include <cmath>
 #include <iostream>
 #include <numbers>
@@ -199,13 +198,12 @@ TEST(GeneratorFamilies, MeanEdgeLengthHalvesPerLevel) {
   }
 }
 
-TEST(GeneratorFamilies, Level6IsFast) {
-  const auto t0 = std::chrono::steady_clock::now();
+TEST(GeneratorFamilies, Level6HasThePapersLargestSize) {
+  // The 81920-triangle mesh of the paper's largest study; how long it takes to build is measured
+  // by bench_geometry (BM_SphereMeshBuild), never asserted here.
   const TriMesh m = sphere_mesh(MeshFamily::MT1, 6);
-  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   EXPECT_EQ(m.num_faces(), 81920);
-  std::cout << "[ info ] mt1 level 6 built in " << s << " s\n";
-  EXPECT_LT(s, 2.0);  // generous: shared machines; typically well under a second
+  EXPECT_EQ(m.num_vertices(), 40962);
 }
 
 TEST(GeneratorRivara, OnePassSplitsEveryTriangle) {
