@@ -11,27 +11,13 @@
 #include <set>
 
 #include "bendlab/core/atomic_file.hpp"
+#include "bendlab/core/file_input.hpp"
 #include "mesh_io_detail.hpp"
 
 namespace bendlab {
 namespace io_detail {
 
-std::string read_file(const std::filesystem::path& path) {
-  std::error_code ec;
-  const auto status = std::filesystem::status(path, ec);
-  if (ec || !std::filesystem::exists(status))
-    throw Error(fmt::format("cannot read '{}': no such file", path.string()));
-  if (std::filesystem::is_directory(status))
-    throw Error(fmt::format("cannot read '{}': it is a directory", path.string()));
-  const auto size = std::filesystem::file_size(path, ec);
-  std::ifstream in(path, std::ios::binary);
-  if (ec || !in) throw Error(fmt::format("cannot read '{}': cannot open the file", path.string()));
-  std::string bytes(static_cast<std::size_t>(size), '\0');
-  in.read(bytes.data(), static_cast<std::streamsize>(size));
-  if (in.gcount() != static_cast<std::streamsize>(size))
-    throw Error(fmt::format("cannot read '{}': read error after {} of {} bytes", path.string(), in.gcount(), size));
-  return bytes;
-}
+std::string read_file(const std::filesystem::path& path) { return read_regular_file(path); }
 
 std::string shown(std::string_view token) {
   constexpr std::size_t max_chars = 40;
@@ -188,6 +174,13 @@ RawMesh read_raw_mesh(const std::filesystem::path& path) {
   if (ext == ".off") return io_detail::read_off(path, bytes);
   if (ext == ".obj") return io_detail::read_obj(path, bytes);
   return io_detail::read_ply(path, bytes);
+}
+
+RawMesh parse_raw_mesh(const std::string& bytes, const std::string& format, const std::filesystem::path& name) {
+  if (format == "off") return io_detail::read_off(name, bytes);
+  if (format == "obj") return io_detail::read_obj(name, bytes);
+  if (format == "ply") return io_detail::read_ply(name, bytes);
+  throw Error(fmt::format("parse_raw_mesh: unknown format '{}' (expected off, obj or ply)", format));
 }
 
 TriMesh read_mesh(const std::filesystem::path& path, MeshOptions options) {

@@ -1,4 +1,5 @@
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -465,7 +466,7 @@ TEST_F(MeshIo, MalformedFilesGiveOneLineErrorsWithFileAndPosition) {
 TEST_F(MeshIo, MissingFileAndUnknownExtension) {
   const std::string missing = error_of([&] { read_raw_mesh(file("nothing.off")); });
   EXPECT_NE(missing.find("nothing.off"), std::string::npos) << missing;
-  EXPECT_NE(missing.find("no such file"), std::string::npos) << missing;
+  EXPECT_NE(missing.find("No such file or directory"), std::string::npos) << missing;
   const auto stl = write_bytes("m.stl", "solid\n");
   const std::string ext = error_of([&] { read_raw_mesh(stl); });
   EXPECT_NE(ext.find("m.stl"), std::string::npos) << ext;
@@ -473,7 +474,27 @@ TEST_F(MeshIo, MissingFileAndUnknownExtension) {
   const std::string none = error_of([&] { read_raw_mesh(file("noext")); });
   EXPECT_NE(none.find("extension none"), std::string::npos) << none;
   fs::create_directories(file("dir.off"));
-  EXPECT_NE(error_of([&] { read_raw_mesh(file("dir.off")); }).find("directory"), std::string::npos);
+  EXPECT_NE(error_of([&] { read_raw_mesh(file("dir.off")); }).find("a folder"), std::string::npos);
+}
+
+TEST_F(MeshIo, SpecialFilesAreRefusedAtOnce) {
+  // Opening a FIFO for reading would wait for a writer forever; it is refused before opening.
+  const fs::path fifo = file("pipe.off");
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const std::string e = error_of([&] { read_raw_mesh(fifo); });
+  EXPECT_NE(e.find("pipe.off"), std::string::npos) << e;
+  EXPECT_NE(e.find("FIFO"), std::string::npos) << e;
+  const std::string dev = error_of([&] { read_raw_mesh("/dev/null.off"); });
+  EXPECT_NE(dev.find("No such file"), std::string::npos) << dev;
+}
+
+TEST_F(MeshIo, ParseFromMemoryEqualsReadingTheFile) {
+  const std::string off = "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+  const RawMesh a = read_raw_mesh(write_bytes("t.off", off));
+  const RawMesh b = parse_raw_mesh(off, "off", "memory.off");
+  EXPECT_EQ(a.positions, b.positions);
+  EXPECT_EQ(a.faces, b.faces);
+  EXPECT_THROW(parse_raw_mesh(off, "stl", "memory.stl"), Error);
 }
 
 TEST_F(MeshIo, IndexPastTheLastVertexIsLeftToValidation) {

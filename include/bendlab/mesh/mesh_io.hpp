@@ -57,8 +57,13 @@ struct RawMesh {
   Faces faces;
 };
 
-/// Reads a .off, .obj or .ply file (see above). Throws bendlab::Error.
+/// Reads a .off, .obj or .ply file (see above). Only regular files are read (a FIFO, device or
+/// folder is refused at once); I/O errors give the operating system's reason. Throws bendlab::Error.
 RawMesh read_raw_mesh(const std::filesystem::path& path);
+
+/// Parses the bytes of a mesh file held in memory; format is "off", "obj" or "ply", and `name`
+/// stands for the file in error messages. Throws bendlab::Error as read_raw_mesh.
+RawMesh parse_raw_mesh(const std::string& bytes, const std::string& format, const std::filesystem::path& name);
 
 /// read_raw_mesh, then TriMesh validation. Throws bendlab::Error for a file that cannot be read
 /// and MeshError (whose message then also names the file) for a mesh that TriMesh refuses.
