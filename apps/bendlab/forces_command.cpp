@@ -14,7 +14,7 @@ namespace {
 
 struct ForcesArgs {
   std::string mesh, method, shape, out;
-  double kappa_b = 1.0, radius = 1.0;
+  double kappa_b = 1.0, radius = 1.0, surface_tolerance = 1e-6;
   int rings = 0;
   bool small_angle = false;
   std::vector<double> axes;
@@ -31,6 +31,7 @@ void run_forces(const ForcesArgs& a) {
   std::unique_ptr<AnalyticSurface> surface;
   if (!a.shape.empty()) surface = surface_from_options(a.shape, a.radius, a.axes);
   const TriMesh mesh = read_mesh(a.mesh);
+  if (surface) require_nodes_on_surface(*surface, mesh.positions(), a.surface_tolerance);
 
   const BendingResult r = method->compute(mesh.topology(), mesh.positions(), a.kappa_b);
   SurfaceFields exact;
@@ -89,6 +90,10 @@ const CommandRegistration registration([](CLI::App& app) {
                                           "sphere, rbc, oblate or prolate")
       ->check(CLI::IsMember({"sphere", "rbc", "oblate", "prolate"}));
   cmd->add_option("--radius", args->radius, "radius of the analytic sphere or RBC")->capture_default_str();
+  cmd->add_option("--surface-tolerance", args->surface_tolerance,
+                  "largest distance of a node from the --shape surface, relative to its size; a mesh with a node "
+                  "farther away is refused")
+      ->capture_default_str();
   cmd->add_option("--axes", args->axes, "spheroid half-axes a,c")->delimiter(',')->expected(2);
   cmd->add_option("--out", args->out,
                   "output: .csv (x,y,z,nx,ny,nz,H,K,lapH,fx,fy,fz,Fx,Fy,Fz,area[,exact_...,err_...]) or .vtp")

@@ -11,7 +11,7 @@ namespace {
 
 struct ShapeArgs {
   std::string mesh, shape = "rbc", out;
-  double kappa_b = 1.0, radius = 1.0;
+  double kappa_b = 1.0, radius = 1.0, surface_tolerance = 1e-6;
   std::vector<double> axes;
 };
 
@@ -21,6 +21,7 @@ void run_shape(const ShapeArgs& a) {
   require_writable_parent("--out", a.out);
   const auto surface = surface_from_options(a.shape, a.radius, a.axes);
   const TriMesh mesh = read_mesh(a.mesh);
+  require_nodes_on_surface(*surface, mesh.positions(), a.surface_tolerance);
   const SurfaceFields s = surface->evaluate(mesh.positions(), a.kappa_b);
   if (extension_of(a.out) == ".csv") {
     CsvTable t;
@@ -49,6 +50,10 @@ const CommandRegistration registration([](CLI::App& app) {
       ->check(CLI::IsMember({"sphere", "rbc", "oblate", "prolate"}))->capture_default_str();
   cmd->add_option("--kappa-b", args->kappa_b, "bending modulus kB")->capture_default_str();
   cmd->add_option("--radius", args->radius, "sphere radius, or the RBC's large half-axis R")->capture_default_str();
+  cmd->add_option("--surface-tolerance", args->surface_tolerance,
+                  "largest distance of a node from the --shape surface, relative to its size; a mesh with a node "
+                  "farther away is refused")
+      ->capture_default_str();
   cmd->add_option("--axes", args->axes, "spheroid half-axes a,c (equatorial, polar)")->delimiter(',')->expected(2);
   cmd->add_option("--out", args->out, "output: .csv (x,y,z,nx,ny,nz,H,K,lapH,fx,fy,fz,f_normal) or .vtp")->required();
   cmd->callback([args] { run_shape(*args); });

@@ -1,5 +1,7 @@
 #include "bendlab/surfaces/analytic_surface.hpp"
 
+#include <fmt/format.h>
+
 #include <cmath>
 
 #include "bendlab/surfaces/surface_of_revolution.hpp"
@@ -14,6 +16,28 @@ void require_length(const std::string& what, double v) {
 }
 
 }  // namespace
+
+SurfaceOffset max_offset(const AnalyticSurface& surface, const Points& x) {
+  SurfaceOffset worst;
+  for (Eigen::Index i = 0; i < x.rows(); ++i) {
+    const double d = surface.offset(row(x, i));
+    if (!(d <= worst.max)) {  // NaN counts as the worst
+      worst.max = d;
+      worst.node = i;
+      if (std::isnan(d)) break;
+    }
+  }
+  return worst;
+}
+
+void require_nodes_on_surface(const AnalyticSurface& surface, const Points& x, double relative_tolerance) {
+  const SurfaceOffset w = max_offset(surface, x);
+  const double limit = relative_tolerance * surface.size();
+  if (!(w.max <= limit))
+    throw Error(fmt::format("the mesh nodes do not lie on the {} surface: node {} is {:.3g} away from it (tolerance "
+                            "{:.3g}); compare against the surface the mesh was made for",
+                            surface.name(), w.node, w.max, limit));
+}
 
 SurfaceFields AnalyticSurface::evaluate(const Points& x, double kappa_b) const {
   const Eigen::Index n = x.rows();

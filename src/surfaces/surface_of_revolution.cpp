@@ -188,6 +188,24 @@ SurfaceValues SurfaceOfRevolution::at(const Vec3& x, double kappa_b) const {
   return from_meridian(m, cphi, sphi, kappa_b);
 }
 
+double SurfaceOfRevolution::offset(const Vec3& x) const {
+  // at() identifies x with the curve point of direction (rho, cos t); measure the distance in the
+  // meridian plane from (|x_xy|, z) to that point (A sin t, cos t Z(sin^2 t)).
+  const double rxy = std::hypot(x.x(), x.y());
+  const double rho = rxy / A_;
+  const double cos_t = x.z() / height_factor(std::min(rho * rho, 1.0));
+  const double norm = std::hypot(rho, cos_t);
+  if (!(norm > 0)) return std::hypot(rxy, x.z()) + A_;  // the origin (or NaN): on no surface
+  const double st = rho / norm, ct = cos_t / norm;
+  return std::hypot(rxy - A_ * st, x.z() - ct * height_factor(st * st));
+}
+
+double SurfaceOfRevolution::size() const {
+  double zmax = 0;
+  for (int k = 0; k <= 100; ++k) zmax = std::max(zmax, height_factor(k / 100.0));
+  return std::max(A_, zmax);
+}
+
 SurfaceValues SurfaceOfRevolution::at_angles(double t, double phi, double kappa_b) const {
   return from_meridian(meridian(t), std::cos(phi), std::sin(phi), kappa_b);
 }

@@ -188,3 +188,16 @@ TEST_F(Cli, ShearWritesItsFilesAndResumes) {
   expect_refused(run("shear --mesh mt1:320 --G 0.2 --t-end 0.6 --resume --out " + out.string()), "--G",
                  out / "nothing");
 }
+
+TEST_F(Cli, ComparingWithASurfaceTheNodesAreNotOnIsRefused) {
+  const fs::path sphere = dir / "sphere.off";
+  ASSERT_EQ(run("mesh --family mt1 --level 2 --out " + sphere.string()).status, 0);
+  const fs::path out = dir / "f.csv";
+  expect_refused(run("forces --mesh " + sphere.string() + " --method C --shape rbc --out " + out.string()),
+                 "do not lie on the rbc surface", out);
+  const fs::path shape = dir / "s.csv";
+  expect_refused(run("shape --mesh " + sphere.string() + " --shape rbc --out " + shape.string()),
+                 "do not lie on the rbc surface", shape);
+  // The same mesh against the surface it was made for is accepted.
+  EXPECT_EQ(run("forces --mesh " + sphere.string() + " --method C --shape sphere --out " + out.string()).status, 0);
+}

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <fstream>
 #include <limits>
+#include <random>
 #include <nlohmann/json.hpp>
 #include <vector>
 
@@ -325,3 +326,55 @@ TEST(MakeSurface, ByNameAndErrors) {
 }
 
 }  // namespace
+
+TEST(SurfaceOffset, NodesMappedOntoASurfaceLieOnIt) {
+  // Random unit-sphere points (both poles and the equator included) mapped onto each surface.
+  Points p(203, 3);
+  std::mt19937 rng(7);
+  std::normal_distribution<double> g;
+  for (int i = 0; i < 200; ++i) {
+    const Vec3 v(g(rng), g(rng), g(rng));
+    p.row(i) = v.normalized().transpose();
+  }
+  p.row(200) << 0, 0, 1;
+  p.row(201) << 0, 0, -1;
+  p.row(202) << 1, 0, 0;
+  for (const auto& s : {make_sphere(2.5), make_rbc(1.0), make_rbc(3.0), make_surface("oblate"), make_surface("prolate")}) {
+    const Points x = s->map_from_unit_sphere(p);
+    EXPECT_LT(max_offset(*s, x).max, 1e-14 * s->size()) << s->name();
+    EXPECT_NO_THROW(require_nodes_on_surface(*s, x));
+  }
+}
+
+TEST(SurfaceOffset, MeasuresTheDistanceOffASphereExactly) {
+  const auto s = make_sphere(2.0);
+  EXPECT_NEAR(s->offset(Vec3(0, 0, 2.5)), 0.5, 1e-15);
+  EXPECT_NEAR(s->offset(Vec3(1.2, -1.6, 0)), 0.0, 1e-15);
+  EXPECT_NEAR(s->offset(Vec3(0.3, 0.4, 0)), 1.5, 1e-15);
+}
+
+TEST(SurfaceOffset, NodesOfAnotherSurfaceAreRefusedNamingTheNode) {
+  Points p(3, 3);
+  p << 1, 0, 0, 0, 1, 0, 0, 0.6, 0.8;
+  const auto sphere = make_sphere(1.0);
+  const auto rbc = make_rbc(1.0);
+  // Unit-sphere nodes against the RBC: the equator is on both, the third node is not.
+  const SurfaceOffset w = max_offset(*rbc, p);
+  EXPECT_EQ(w.node, 2);
+  EXPECT_GT(w.max, 0.1);
+  try {
+    require_nodes_on_surface(*rbc, p);
+    FAIL() << "expected bendlab::Error";
+  } catch (const Error& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("node 2"), std::string::npos) << m;
+    EXPECT_NE(m.find("rbc"), std::string::npos) << m;
+  }
+  EXPECT_NO_THROW(require_nodes_on_surface(*sphere, p));
+  // Scaled by 1 + 1e-4: refused at the default tolerance, accepted at a looser one.
+  EXPECT_THROW(require_nodes_on_surface(*sphere, 1.0001 * p), Error);
+  EXPECT_NO_THROW(require_nodes_on_surface(*sphere, 1.0001 * p, 1e-3));
+  Points bad = p;
+  bad(1, 2) = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(require_nodes_on_surface(*sphere, bad), Error);
+}

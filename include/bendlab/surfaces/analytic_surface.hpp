@@ -45,9 +45,28 @@ class AnalyticSurface {
   /// Maps points of the unit sphere onto this surface (the map the mesh families use).
   virtual Points map_from_unit_sphere(const Points& unit_sphere_points) const = 0;
 
+  /// How far x lies from the surface point whose values at(x) returns (zero, to rounding, for a
+  /// point on the surface). An upper bound of the distance to the surface, and the error of
+  /// position that a comparison against at(x) carries.
+  virtual double offset(const Vec3& x) const = 0;
+  /// A length of the surface's size (its largest half-axis), for relative tolerances.
+  virtual double size() const = 0;
+
   /// at() for every row of x.
   SurfaceFields evaluate(const Points& x, double kappa_b = 1.0) const;
 };
+
+/// The largest offset() over the rows of x, and the row where it occurs.
+struct SurfaceOffset {
+  double max = 0;
+  Eigen::Index node = -1;
+};
+SurfaceOffset max_offset(const AnalyticSurface& surface, const Points& x);
+
+/// Throws bendlab::Error, naming the node and its offset, when a row of x lies farther than
+/// relative_tolerance * surface.size() from the surface: values compared against the surface
+/// would then be compared at the wrong place. Non-finite rows are refused too.
+void require_nodes_on_surface(const AnalyticSurface& surface, const Points& x, double relative_tolerance = 1e-6);
 
 /// Sphere of radius R: H = 1/R, K = 1/R^2, lapH = 0, f = 0. Map: scale by R.
 std::unique_ptr<AnalyticSurface> make_sphere(double radius = 1.0);

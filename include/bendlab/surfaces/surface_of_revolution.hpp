@@ -51,6 +51,8 @@ class SurfaceOfRevolution : public AnalyticSurface {
   SurfaceValues at(const Vec3& x, double kappa_b = 1.0) const override;
   SurfaceMaxima maxima(double kappa_b = 1.0) const override;
   Points map_from_unit_sphere(const Points& unit_sphere_points) const override;
+  double offset(const Vec3& x) const override;
+  double size() const override;
 
   /// Values on the curve at polar parameter t in [0, pi].
   MeridianValues meridian(double t) const;
