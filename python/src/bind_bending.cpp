@@ -1,0 +1,100 @@
+// Bending methods: every registered method with its options, and its per-vertex results.
+#include <pybind11/stl.h>
+
+#include <memory>
+
+#include "arrays.hpp"
+#include "bendlab/bending/bending_method.hpp"
+#include "bendlab/mesh/trimesh.hpp"
+#include "bindings.hpp"
+
+namespace bendlab::python {
+
+namespace {
+
+/// Method options as the command line spells them: every value becomes a string (True -> "true").
+MethodOptions options_from(const py::dict& kwargs) {
+  MethodOptions o;
+  for (auto [k, v] : kwargs) {
+    std::string value;
+    if (py::isinstance<py::bool_>(v)) value = v.cast<bool>() ? "true" : "false";
+    else value = py::str(v);
+    o[py::str(k)] = value;
+  }
+  return o;
+}
+
+void require_kappa(double kappa_b) {
+  if (!std::isfinite(kappa_b) || kappa_b < 0) throw Error("kappa_b must be a finite number >= 0");
+}
+
+/// A method with the options it was made with (methods are immutable and may be shared).
+struct PyMethod {
+  std::shared_ptr<const BendingMethod> method;
+};
+
+}  // namespace
+
+void bind_bending(py::module_& m) {
+  py::class_<BendingResult>(m, "BendingResult",
+                            "Per-vertex results of one bending method (docs/conventions.md §1). Arrays are "
+                            "read-only views of the result; quantities the method does not define are NaN.")
+      .def_property_readonly("normal", [](py::object s) { return view(s.cast<const BendingResult&>().normal, s); },
+                             "(N, 3) unit outward normal the method uses")
+      .def_property_readonly("H", [](py::object s) { return view(s.cast<const BendingResult&>().H, s); },
+                             "(N,) mean curvature, H > 0 on a sphere")
+      .def_property_readonly("K", [](py::object s) { return view(s.cast<const BendingResult&>().K, s); },
+                             "(N,) Gaussian curvature")
+      .def_property_readonly("lapH", [](py::object s) { return view(s.cast<const BendingResult&>().lapH, s); },
+                             "(N,) Laplace-Beltrami of H (div grad)")
+      .def_property_readonly("force", [](py::object s) { return view(s.cast<const BendingResult&>().force, s); },
+                             "(N, 3) node force F (eq. 14: F = f A_mixed)")
+      .def_property_readonly("force_density",
+                             [](py::object s) { return view(s.cast<const BendingResult&>().force_density, s); },
+                             "(N, 3) force density f = 2 kB (Lap H + 2 H (H^2 - K)) n (eq. 10)")
+      .def_property_readonly("area", [](py::object s) { return view(s.cast<const BendingResult&>().area, s); },
+                             "(N,) Meyer's mixed area used for F <-> f")
+      .def_property_readonly("energy", [](const BendingResult& r) { return r.energy; },
+                             "bending energy E_B for energy-based methods, else None");
+
+  py::class_<PyMethod>(m, "Method",
+                       "A bending method of the paper (A Kantor-Nelson, B Gompper-Kroll, C Meyer, D Belkin, "
+                       "E Farutin, ED, S Loop shell) with its options, e.g. Method('E', rings=2). "
+                       "bendlab.methods() lists them.")
+      .def(py::init([](const std::string& name, const py::kwargs& options) {
+             return PyMethod{std::shared_ptr<const BendingMethod>(make_bending_method(name, options_from(options)))};
+           }),
+           py::arg("name"))
+      .def_property_readonly("name", [](const PyMethod& p) { return p.method->name(); })
+      .def(
+          "compute",
+          [](const PyMethod& p, const TriMesh& mesh, double kappa_b) {
+            require_kappa(kappa_b);
+            py::gil_scoped_release release;
+            return p.method->compute(mesh.topology(), mesh.positions(), kappa_b);
+          },
+          py::arg("mesh"), py::arg("kappa_b") = 1.0,
+          "Every per-vertex quantity: normal, H, K, lapH, force, force_density, area, energy.")
+      .def(
+          "forces",
+          [](const PyMethod& p, const TriMesh& mesh, double kappa_b) {
+            require_kappa(kappa_b);
+            Points f;
+            {
+              py::gil_scoped_release release;
+              p.method->forces(mesh.topology(), mesh.positions(), kappa_b, f);
+            }
+            return take(std::move(f));
+          },
+          py::arg("mesh"), py::arg("kappa_b") = 1.0, "Node forces F, (N, 3): what a flow solver needs.")
+      .def(
+          "energy",
+          [](const PyMethod& p, const TriMesh& mesh, double kappa_b) {
+            require_kappa(kappa_b);
+            return p.method->energy(mesh.topology(), mesh.positions(), kappa_b);
+          },
+          py::arg("mesh"), py::arg("kappa_b") = 1.0, "E_B for energy-based methods (A, B, S), else None.")
+      .def("__repr__", [](const PyMethod& p) { return "<bendlab.Method " + p.method->name() + ">"; });
+}
+
+}  // namespace bendlab::python
