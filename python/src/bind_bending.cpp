@@ -1,6 +1,7 @@
 // Bending methods: every registered method with its options, and its per-vertex results.
 #include <pybind11/stl.h>
 
+#include <chrono>
 #include <memory>
 
 #include "arrays.hpp"
@@ -94,7 +95,21 @@ void bind_bending(py::module_& m) {
             return p.method->energy(mesh.topology(), mesh.positions(), kappa_b);
           },
           py::arg("mesh"), py::arg("kappa_b") = 1.0, "E_B for energy-based methods (A, B, S), else None.")
-      .def("__repr__", [](const PyMethod& p) { return "<bendlab.Method " + p.method->name() + ">"; });
+      .def("__repr__", [](const PyMethod& p) { return "<bendlab.Method " + p.method->name() + ">"; })
+      .def(
+          "_seconds_per_compute_in_cpp",
+          [](const PyMethod& p, const TriMesh& mesh, double kappa_b, int repeats) {
+            // For scripts/bench_python.py: the same call timed inside C++, to measure what the
+            // binding layer adds. Not part of the API.
+            py::gil_scoped_release release;
+            const auto t0 = std::chrono::steady_clock::now();
+            for (int k = 0; k < repeats; ++k) {
+              const BendingResult r = p.method->compute(mesh.topology(), mesh.positions(), kappa_b);
+              if (r.force.rows() != mesh.num_vertices()) throw Error("unexpected result size");
+            }
+            return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() / repeats;
+          },
+          py::arg("mesh"), py::arg("kappa_b") = 1.0, py::arg("repeats") = 100);
 }
 
 }  // namespace bendlab::python

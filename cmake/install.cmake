@@ -1,0 +1,25 @@
+# cmake --install: the libraries, the headers, the CLI, the plotting scripts and a CMake package
+# (find_package(bendlab) giving bendlab::bendlab and one bendlab::<stage> target per library).
+include(GNUInstallDirs)
+include(CMakePackageConfigHelpers)
+
+foreach(lib ${BENDLAB_LIBRARY_TARGETS})
+  string(REPLACE "bendlab_" "" short ${lib})
+  set_target_properties(${lib} PROPERTIES EXPORT_NAME ${short})
+endforeach()
+install(TARGETS ${BENDLAB_LIBRARY_TARGETS} bendlab EXPORT bendlabTargets
+        ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
+        LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
+        INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/include/bendlab DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+install(TARGETS bendlab_cli RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+# The CLI finds its plotting scripts in <prefix>/share/bendlab/scripts (core/helper_program.hpp).
+install(FILES ${PROJECT_SOURCE_DIR}/scripts/plot_rbc.py ${PROJECT_SOURCE_DIR}/scripts/plot_shear.py
+        DESTINATION ${CMAKE_INSTALL_DATADIR}/bendlab/scripts)
+install(EXPORT bendlabTargets NAMESPACE bendlab:: DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/bendlab)
+configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/bendlabConfig.cmake.in
+                              ${PROJECT_BINARY_DIR}/bendlabConfig.cmake
+                              INSTALL_DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/bendlab)
+write_basic_package_version_file(${PROJECT_BINARY_DIR}/bendlabConfigVersion.cmake COMPATIBILITY SameMinorVersion)
+install(FILES ${PROJECT_BINARY_DIR}/bendlabConfig.cmake ${PROJECT_BINARY_DIR}/bendlabConfigVersion.cmake
+        DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/bendlab)
