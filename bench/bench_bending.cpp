@@ -108,7 +108,8 @@ void register_all() {
         const std::string name = "BM_Compute/" + info.name + "_rings" + std::to_string(rings);
         auto* b = benchmark::RegisterBenchmark(name.c_str(), BM_Compute, info.name,
                                                MethodOptions{{"rings", std::to_string(rings)}});
-        b->ArgsProduct({{5120}, {1, 2}})->ArgNames({"triangles", "threads"})->UseRealTime()->Unit(benchmark::kMillisecond);
+        b->ArgsProduct({{5120}, {1, 2}})->ArgNames({"triangles", "threads"})->UseRealTime()
+            ->Unit(benchmark::kMillisecond);
       }
     }
   }

@@ -14,7 +14,8 @@ namespace {
 std::string format_number(double v) { return fmt::format("{}", v); }
 
 nlohmann::ordered_json option_json(const OptionSpec& s) {
-  nlohmann::ordered_json j = {{"name", s.name}, {"type", to_string(s.type)}, {"default", s.default_value}, {"help", s.help}};
+  nlohmann::ordered_json j = {
+      {"name", s.name}, {"type", to_string(s.type)}, {"default", s.default_value}, {"help", s.help}};
   if (s.type == OptionType::Int) {
     j["min"] = static_cast<long>(s.min);
     j["max"] = static_cast<long>(s.max);

@@ -236,7 +236,8 @@ FarutinFields farutin_fields(const std::vector<FarutinFit>& fits) {
 }
 
 OptionSpec farutin_rings_option() {
-  return int_option("rings", 1, 3, 1, "fitting support in rings of neighbours (widened where fewer than 5 or singular)");
+  return int_option("rings", 1, 3, 1,
+                    "fitting support in rings of neighbours (widened where fewer than 5 or singular)");
 }
 
 int parse_farutin_rings(const MethodOptions& options, const std::string& method) {
