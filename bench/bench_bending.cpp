@@ -4,14 +4,17 @@
 //   ./build/release/bench_bending --benchmark_filter='BM_Compute/C/'
 //
 // Benchmarks (arguments: triangles, OpenMP threads):
-//   BM_Compute/<method>    BendingMethod::compute (every per-vertex quantity), methods A..E, ED
-//   BM_Forces/<method>     BendingMethod::forces (node forces only) where the method overrides it (A, B)
-//   BM_Compute/E_rings<R>  Method E with neighbourhoods of R = 2 and 3 rings, 5120 triangles
+//   BM_Compute/<method>    BendingMethod::compute (every per-vertex quantity), every registered method
+//                          (`bendlab methods`: A..E, ED)
+//   BM_Forces/<method>     BendingMethod::forces (node forces only) of the energy methods (A, B), which
+//                          override it
+//   BM_Compute/E_rings<R>  Method E with neighbourhoods of R = 2 and 3 rings, 5120 triangles (every
+//                          O(N) method with a "rings" option)
 // Counters: vertices_per_s (vertices / wall-clock second) and vertices_per_s_per_thread (the same
 // divided by the OpenMP threads). Times are wall-clock (UseRealTime), since the work runs on
 // OpenMP threads.
 //
-// Methods D and ED are O(N^2) (Belkin's heat kernel sums over every vertex pair): at 81920
+// Methods D and ED are O(N^2) (their registry cost class) (Belkin's heat kernel sums over every vertex pair): at 81920
 // triangles (40962 vertices) they run a single iteration.
 #include <benchmark/benchmark.h>
 #include <omp.h>
@@ -20,7 +23,7 @@
 #include <memory>
 #include <string>
 
-#include "bendlab/bending/bending_method.hpp"
+#include "bendlab/bending/method_registry.hpp"
 #include "bendlab/mesh/generators.hpp"
 #include "bendlab/surfaces/analytic_surface.hpp"
 
@@ -77,10 +80,11 @@ void BM_Forces(benchmark::State& state, const std::string& method) {
   set_counters(state, mesh, threads);
 }
 
+// Every registered method (bending/method_registry.hpp); its cost class decides the iterations.
 void register_all() {
-  const char* methods[] = {"A", "B", "C", "D", "E", "ED"};
-  for (const std::string method : methods) {
-    const bool quadratic = method == "D" || method == "ED";
+  for (const MethodInfo& info : bending_methods()) {
+    const std::string method = info.name;
+    const bool quadratic = info.capabilities.cost == "O(N^2)";
     for (const int triangles : {5120, 81920}) {
       for (const int threads : {1, 2}) {
         auto* b = benchmark::RegisterBenchmark(("BM_Compute/" + method).c_str(), BM_Compute, method, MethodOptions{});
@@ -89,15 +93,25 @@ void register_all() {
       }
     }
   }
-  for (const std::string method : {"A", "B"}) {
+  for (const MethodInfo& info : bending_methods()) {
+    if (!info.capabilities.has_energy) continue;  // the energy methods have their own force kernel
+    const std::string method = info.name;
     auto* b = benchmark::RegisterBenchmark(("BM_Forces/" + method).c_str(), BM_Forces, method);
     b->ArgsProduct({{5120, 81920}, {1, 2}})->ArgNames({"triangles", "threads"})->UseRealTime()->Unit(benchmark::kMillisecond);
   }
-  for (const int rings : {2, 3}) {
-    const std::string name = "BM_Compute/E_rings" + std::to_string(rings);
-    auto* b = benchmark::RegisterBenchmark(name.c_str(), BM_Compute, std::string("E"),
-                                           MethodOptions{{"rings", std::to_string(rings)}});
-    b->ArgsProduct({{5120}, {1, 2}})->ArgNames({"triangles", "threads"})->UseRealTime()->Unit(benchmark::kMillisecond);
+  // Wider neighbourhoods of the linear-cost methods with a "rings" option (E).
+  for (const MethodInfo& info : bending_methods()) {
+    if (info.capabilities.cost != "O(N)") continue;
+    for (const OptionSpec& o : info.options) {
+      if (o.name != "rings") continue;
+      for (int rings = static_cast<int>(o.min) + 1; rings <= static_cast<int>(o.max); ++rings) {
+        const std::string name = "BM_Compute/" + info.name + "_rings" + std::to_string(rings);
+        auto* b = benchmark::RegisterBenchmark(name.c_str(), BM_Compute, info.name,
+                                               MethodOptions{{"rings", std::to_string(rings)}});
+        b->ArgsProduct({{5120}, {1, 2}})->ArgNames({"triangles", "threads"})->UseRealTime()
+            ->Unit(benchmark::kMillisecond);
+      }
+    }
   }
 }
 

@@ -54,7 +54,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
-METHODS = ["A", "B", "C", "D", "E", "ED"]
+METHODS = []  # the bending methods, from `bendlab methods --json` (set in main)
 G_SWEEP = [0.0125, 0.025, 0.05, 0.1, 0.2]
 PAIRS = [(0.05, 0.0375), (0.2, 0.15)]
 
@@ -94,6 +94,12 @@ METHOD_STYLE = {
 }
 
 _print_lock = threading.Lock()
+
+
+def bending_methods(bendlab):
+    """The names of the bending methods the binary knows, in its table's order."""
+    out = subprocess.run([str(bendlab), "methods", "--json"], check=True, capture_output=True, text=True).stdout
+    return [m["name"] for m in json.loads(out)]
 
 
 def say(msg):
@@ -456,10 +462,10 @@ def section_b(results, runs, fig_dir, rel, t_end, none_results):
                 if r is not None and r.ok and r.series:
                     curves.append((m, m, r.series))
             for label, key, s in curves:
-                ax.plot(s["gamma_t"], s["D"], label=label, **METHOD_STYLE[key])
+                ax.plot(s["gamma_t"], s["D"], label=label, **METHOD_STYLE.get(key, {}))
                 if ins is not None:
                     sel = s["gamma_t"] >= 5
-                    ins.plot(s["gamma_t"][sel], s["D"][sel], **METHOD_STYLE[key])
+                    ins.plot(s["gamma_t"][sel], s["D"][sel], **METHOD_STYLE.get(key, {}))
             if ins is not None:
                 ins.set_xlim(5, t_end)
                 ins.tick_params(labelsize=7)
@@ -612,6 +618,7 @@ def main():
     if not (bendlab.is_file() and os.access(bendlab, os.X_OK)):
         sys.exit(f"error: no bendlab binary at '{args.bendlab}' (build it: cmake --preset release && "
                  "cmake --build --preset release, or pass --bendlab PATH)")
+    METHODS[:] = bending_methods(bendlab)
     work = Path(args.work).resolve()
     doc = Path(args.doc).resolve()
     fig_dir = doc.with_suffix("")

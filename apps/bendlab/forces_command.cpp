@@ -7,6 +7,7 @@
 #include "bendlab/core/csv.hpp"
 #include "bendlab/mesh/mesh_io.hpp"
 #include "cli_common.hpp"
+#include "method_cli.hpp"
 #include "command.hpp"
 
 namespace bendlab::cli {
@@ -17,6 +18,7 @@ struct ForcesArgs {
   double kappa_b = 1.0, radius = 1.0, surface_tolerance = 1e-6;
   int rings = 0;
   bool small_angle = false;
+  std::vector<std::string> options;  // --option key=value
   std::vector<double> axes;
 };
 
@@ -27,6 +29,7 @@ void run_forces(const ForcesArgs& a) {
   MethodOptions options;
   if (a.rings != 0) options["rings"] = std::to_string(a.rings);
   if (a.small_angle) options["small_angle"] = "true";
+  add_option_assignments(options, a.options);
   const auto method = make_bending_method(a.method, options);
   std::unique_ptr<AnalyticSurface> surface;
   if (!a.shape.empty()) surface = surface_from_options(a.shape, a.radius, a.axes);
@@ -79,13 +82,14 @@ const CommandRegistration registration([](CLI::App& app) {
   auto* cmd = app.add_subcommand("forces", "Compute normals, H, K, Lap H, force density f and node force F "
                                            "of one bending method at every vertex");
   cmd->add_option("--mesh", args->mesh, "input mesh: .off, .obj or .ply")->required()->check(CLI::ExistingFile);
-  cmd->add_option("--method", args->method, "A (Kantor-Nelson), B (Gompper-Kroll), C (Meyer), D (Belkin), "
-                                            "E (Farutin), ED (E for H, K, n; D for Lap H)")
-      ->required()->check(CLI::IsMember({"A", "B", "C", "D", "E", "ED"}));
+  cmd->add_option("--method", args->method, "bending method: " + method_choices_help() + " (bendlab methods)")
+      ->required()->check(CLI::IsMember(bending_method_names()));
   cmd->add_option("--kappa-b", args->kappa_b, "bending modulus kB")->capture_default_str();
   cmd->add_option("--rings", args->rings, "fitting support of E and ED in rings of neighbours (1, 2, 3)")
       ->check(CLI::Range(1, 3));
   cmd->add_flag("--small-angle", args->small_angle, "method A: small-angle form theta^2/2 of 1 - cos(theta)");
+  cmd->add_option("--option", args->options, "method option key=value, repeatable (the options of each method: "
+                                             "bendlab methods), e.g. --option rings=2");
   cmd->add_option("--shape", args->shape, "also write the analytic values and errors (eq. 17) of this surface: "
                                           "sphere, rbc, oblate or prolate")
       ->check(CLI::IsMember({"sphere", "rbc", "oblate", "prolate"}));

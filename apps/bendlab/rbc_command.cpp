@@ -11,6 +11,7 @@
 #include "bendlab/analysis/rbc_study.hpp"
 #include "bendlab/core/helper_program.hpp"
 #include "cli_common.hpp"
+#include "method_cli.hpp"
 #include "command.hpp"
 
 namespace bendlab::cli {
@@ -20,7 +21,7 @@ namespace fs = std::filesystem;
 
 struct RbcArgs {
   std::vector<std::string> families = {"mt1", "mt2", "octa", "inhomogeneous"};
-  std::vector<std::string> methods = {"A", "B", "C", "D", "E", "ED"};
+  std::vector<std::string> methods = bending_method_names();
   int max_triangles = 81920;  // the paper's largest meshes; the whole study takes well under a minute
   int rings = 0;  // 0: the methods' default
   std::string out;
@@ -94,7 +95,7 @@ std::vector<std::string> split_list(const std::string& s) {
 const CommandRegistration registration([](CLI::App& app) {
   auto args = std::make_shared<RbcArgs>();
   auto families = std::make_shared<std::string>("mt1,mt2,octa,inhomogeneous");
-  auto methods = std::make_shared<std::string>("A,B,C,D,E,ED");
+  auto methods = std::make_shared<std::string>(method_names_joined(","));
   auto* cmd = app.add_subcommand(
       "rbc",
       "Static RBC benchmark (paper section 3): errors of each method against the exact red blood cell "
@@ -111,7 +112,7 @@ const CommandRegistration registration([](CLI::App& app) {
   cmd->add_option("--max-triangles", args->max_triangles,
                   "largest homogeneous mesh, at least 320 (320, 1280, 5120, 20480, 81920 for MT1/MT2)")
       ->capture_default_str();
-  cmd->add_option("--methods", *methods, "comma-separated bending methods among A, B, C, D, E, ED")
+  cmd->add_option("--methods", *methods, "comma-separated bending methods among " + method_names_joined())
       ->capture_default_str();
   cmd->add_option("--rings", args->rings, "neighbour rings of the fits of Methods E and ED (1, 2 or 3; "
                                           "default: the methods' own default)");

@@ -22,6 +22,7 @@
 #include "bendlab/mesh/generators.hpp"
 #include "bendlab/mesh/mesh_io.hpp"
 #include "cli_common.hpp"
+#include "method_cli.hpp"
 #include "command.hpp"
 
 namespace fs = std::filesystem;
@@ -120,7 +121,7 @@ void run_shear(const ShearArgs& a) {
   require_positive("--rtol", a.rtol);
   require_positive("--atol", a.atol);
   if (a.method == "none" && a.kappa_b > 0)
-    throw Error("--kappa-b > 0 needs a bending --method (A, B, C, D, E or ED)");
+    throw Error("--kappa-b > 0 needs a bending --method (" + method_names_joined() + ")");
   std::unique_ptr<BendingMethod> bending;
   if (a.method != "none") {
     MethodOptions options;
@@ -256,8 +257,8 @@ const CommandRegistration registration([](CLI::App& app) {
                                           "bending) in linear shear flow u = gamma z e_x at zero Reynolds number");
   cmd->add_option("--solver", args->solver, "flow solver: bim (boundary integral method)")
       ->check(CLI::IsMember({"bim"}))->capture_default_str();
-  cmd->add_option("--method", args->method, "bending method: none, A, B, C, D, E, ED")
-      ->check(CLI::IsMember({"none", "A", "B", "C", "D", "E", "ED"}))->capture_default_str();
+  cmd->add_option("--method", args->method, "bending method: none, " + method_names_joined())
+      ->check(CLI::IsMember(method_choices_with_none()))->capture_default_str();
   cmd->add_option("--rings", args->rings, "fitting support of E and ED (1, 2, 3)")->check(CLI::Range(1, 3));
   cmd->add_option("--mesh", args->mesh, "mt1:N or mt2:N (N triangles: 320, 1280, 5120, ...), inh:mt1 or inh:mt2 "
                                         "(320 triangles + 3 Rivara passes), or a mesh file (.off, .obj, .ply)")

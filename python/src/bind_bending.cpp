@@ -6,6 +6,7 @@
 
 #include "arrays.hpp"
 #include "bendlab/bending/bending_method.hpp"
+#include "bendlab/bending/method_registry.hpp"
 #include "bendlab/mesh/trimesh.hpp"
 #include "bindings.hpp"
 
@@ -37,6 +38,32 @@ struct PyMethod {
 }  // namespace
 
 void bind_bending(py::module_& m) {
+  m.def(
+      "methods",
+      [] {
+        py::list out;
+        for (const MethodInfo& info : bending_methods()) {
+          py::list options;
+          for (const OptionSpec& o : info.options) {
+            py::dict d(py::arg("name") = o.name, py::arg("type") = to_string(o.type),
+                       py::arg("default") = o.default_value, py::arg("help") = o.help);
+            if (o.type == OptionType::Int || o.type == OptionType::Real) d["range"] = py::make_tuple(o.min, o.max);
+            if (o.type == OptionType::Choice) d["choices"] = o.choices;
+            options.append(d);
+          }
+          const MethodCapabilities& c = info.capabilities;
+          py::dict caps(py::arg("has_energy") = c.has_energy, py::arg("defines_normal") = c.defines_normal,
+                        py::arg("defines_H") = c.defines_H, py::arg("defines_K") = c.defines_K,
+                        py::arg("defines_lapH") = c.defines_lapH,
+                        py::arg("needs_admissible_mesh") = c.needs_admissible_mesh, py::arg("cost") = c.cost);
+          out.append(py::dict(py::arg("name") = info.name, py::arg("description") = info.description,
+                              py::arg("options") = options, py::arg("capabilities") = caps));
+        }
+        return out;
+      },
+      "Every registered bending method: name, description, options (name, type, default, range or "
+      "choices, help) and capabilities -- the same table as `bendlab methods --json`.");
+
   py::class_<BendingResult>(m, "BendingResult",
                             "Per-vertex results of one bending method (docs/conventions.md §1). Arrays are "
                             "read-only views of the result; quantities the method does not define are NaN.")

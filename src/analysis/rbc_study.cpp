@@ -17,10 +17,8 @@ constexpr int kMinTriangles = 320;    // MT1/MT2 level 2; the coarsest mesh of t
 constexpr int kRivaraLevel = 2;       // 320 triangles, as in the paper
 constexpr int kRivaraPasses = 3;
 
-bool takes_method_options(const std::string& method) { return method == "E" || method == "ED"; }
-
 MethodOptions options_for(const RbcStudyOptions& o, const std::string& method) {
-  return takes_method_options(method) ? o.method_options : MethodOptions{};
+  return options_for_method(bending_method_info(method), o.method_options);
 }
 
 struct MeshSpec {
@@ -68,6 +66,12 @@ void validate(const RbcStudyOptions& o) {
     if (std::find(rbc_study_families().begin(), rbc_study_families().end(), f) == rbc_study_families().end())
       throw Error(fmt::format("--families: unknown family '{}' (expected mt1, mt2, octa, inhomogeneous)", f));
   if (o.methods.empty()) throw Error("--methods: no method given");
+  for (const auto& [key, value] : o.method_options) {
+    bool taken = false;
+    for (const MethodInfo& m : bending_methods())
+      for (const OptionSpec& s : m.options) taken = taken || s.name == key;
+    if (!taken) throw Error(fmt::format("method option '{}': no bending method takes it", key));
+  }
   std::set<std::string> seen;
   for (const std::string& m : o.methods) {
     if (!seen.insert(m).second) throw Error(fmt::format("--methods: method '{}' given twice", m));

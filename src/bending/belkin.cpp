@@ -5,7 +5,7 @@
 #include <cmath>
 #include <limits>
 
-#include "bendlab/bending/meyer.hpp"
+#include "bendlab/bending/variational_assembly.hpp"
 #include "bendlab/geometry/measures.hpp"
 
 namespace bendlab {
@@ -131,8 +131,15 @@ Points belkin_laplacian(const Topology& topology, const Points& x, const MeshGeo
 }
 
 std::unique_ptr<BendingMethod> BelkinMethod::create(const MethodOptions& options) {
-  if (!options.empty()) throw Error("method D: unknown option '" + options.begin()->first + "'");
+  resolve_method_options(info(), options);  // D takes no options: refuses any
   return std::make_unique<BelkinMethod>();
+}
+
+MethodInfo BelkinMethod::info() {
+  MethodInfo m{"D", "Belkin: heat-kernel Laplace-Beltrami operator in eq. (10), eq. (13)",
+                {}, {}, &BelkinMethod::create};
+  m.capabilities.cost = std::string("O(N^2)");
+  return m;
 }
 
 BendingResult BelkinMethod::compute(const Topology& topology, const Points& x, double kappa_b) const {

@@ -3,7 +3,8 @@
 #include <cmath>
 #include <limits>
 
-#include "bendlab/bending/meyer.hpp"
+#include "bendlab/bending/variational_assembly.hpp"
+#include "bendlab/mesh/neighbourhood.hpp"
 
 namespace bendlab {
 
@@ -99,60 +100,20 @@ FarutinFit invalid_fit() {
   return f;
 }
 
-/// Breadth-first rings around one node, in a buffer reused from node to node.
-class Neighbourhood {
+/// The neighbours of one node (mesh/neighbourhood.hpp) and their positions, in buffers reused
+/// from node to node.
+class Neighbourhood : public VertexRings {
  public:
-  explicit Neighbourhood(const Topology& t) : t_(t) {}
-
-  /// Starts at node i with ring 1.
-  void start(int i) {
-    centre_ = i;
-    list_.assign(t_.ring_vertices().begin() + t_.ring_begin(i), t_.ring_vertices().begin() + t_.ring_end(i));
-    last_ring_begin_ = 0;
-    rings_ = 1;
-    stamped_ = false;
-  }
-  /// Adds the next ring; false (nothing added) when the rings already cover the connected mesh.
-  bool add_ring() {
-    if (!stamped_) {  // marks are only needed beyond ring 1, so ring-1 fits never touch them
-      if (mark_.empty()) mark_.assign(t_.num_vertices(), -1);
-      mark_[centre_] = centre_;
-      for (int j : list_) mark_[j] = centre_;
-      stamped_ = true;
-    }
-    const std::size_t end = list_.size();
-    for (std::size_t k = last_ring_begin_; k < end; ++k) {
-      const int j = list_[k];
-      for (int m = t_.ring_begin(j); m < t_.ring_end(j); ++m) {
-        const int l = t_.ring_vertices()[m];
-        if (mark_[l] != centre_) {
-          mark_[l] = centre_;
-          list_.push_back(l);
-        }
-      }
-    }
-    if (list_.size() == end) return false;
-    last_ring_begin_ = end;
-    ++rings_;
-    return true;
-  }
-  int rings() const { return rings_; }
-  const std::vector<int>& vertices() const { return list_; }
-
+  using VertexRings::VertexRings;
   /// Positions of the neighbours, in the order of vertices().
   std::span<const Vec3> gather(const Points& x) {
-    pts_.resize(list_.size());
-    for (std::size_t k = 0; k < list_.size(); ++k) pts_[k] = x.row(list_[k]).transpose();
+    const std::vector<int>& v = vertices();
+    pts_.resize(v.size());
+    for (std::size_t k = 0; k < v.size(); ++k) pts_[k] = x.row(v[k]).transpose();
     return pts_;
   }
 
  private:
-  const Topology& t_;
-  int centre_ = -1, rings_ = 0;
-  bool stamped_ = false;
-  std::size_t last_ring_begin_ = 0;
-  std::vector<int> list_;
-  std::vector<int> mark_;  ///< mark_[v] == centre_: v already collected (or is the centre)
   std::vector<Vec3> pts_;
 };
 
@@ -253,8 +214,7 @@ Scalars farutin_laplacian(const Topology& t, const Points& x, const std::vector<
         continue;
       }
       nb.start(i);
-      while (nb.rings() < fit.rings && nb.add_ring()) {
-      }
+      nb.grow_to(fit.rings);
       const auto& v = nb.vertices();
       values.resize(v.size());
       for (std::size_t k = 0; k < v.size(); ++k) values[k] = w[v[k]];
@@ -275,17 +235,14 @@ FarutinFields farutin_fields(const std::vector<FarutinFit>& fits) {
   return out;
 }
 
+OptionSpec farutin_rings_option() {
+  return int_option("rings", 1, 3, 1,
+                    "fitting support in rings of neighbours (widened where fewer than 5 or singular)");
+}
+
 int parse_farutin_rings(const MethodOptions& options, const std::string& method) {
-  int rings = 1;
-  for (const auto& [key, value] : options) {
-    if (key != "rings") throw Error("method " + method + ": unknown option '" + key + "' (known: rings)");
-    if (value == "1" || value == "2" || value == "3") {
-      rings = value[0] - '0';
-    } else {
-      throw Error("method " + method + ": option rings must be 1, 2 or 3, got '" + value + "'");
-    }
-  }
-  return rings;
+  const MethodInfo schema{method, "", {farutin_rings_option()}, {}, nullptr};
+  return static_cast<int>(option_int(resolve_method_options(schema, options), "rings"));
 }
 
 FarutinMethod::FarutinMethod(int rings) : rings_(rings) {
@@ -294,6 +251,12 @@ FarutinMethod::FarutinMethod(int rings) : rings_(rings) {
 
 std::unique_ptr<BendingMethod> FarutinMethod::create(const MethodOptions& options) {
   return std::make_unique<FarutinMethod>(parse_farutin_rings(options, "E"));
+}
+
+MethodInfo FarutinMethod::info() {
+  MethodInfo m{"E", "Farutin: least-squares paraboloid fits for n, H, K and Lap H in eq. (10)",
+                {farutin_rings_option()}, {}, &FarutinMethod::create};
+  return m;
 }
 
 BendingResult FarutinMethod::compute(const Topology& topology, const Points& x, double kappa_b) const {

@@ -180,8 +180,16 @@ double gk_kernel(const Topology& t, const Points& x, double kappa_b, Points* for
 }  // namespace
 
 std::unique_ptr<BendingMethod> GompperKroll::create(const MethodOptions& options) {
-  if (!options.empty()) throw Error("method B: unknown option '" + options.begin()->first + "' (it takes none)");
+  resolve_method_options(info(), options);  // B takes no options: refuses any
   return std::make_unique<GompperKroll>();
+}
+
+MethodInfo GompperKroll::info() {
+  MethodInfo m{"B", "Gompper-Kroll: exact gradient of the discrete Helfrich energy, eqs. (A.1)-(A.2)",
+                {}, {}, &GompperKroll::create};
+  m.capabilities.has_energy = true;
+  m.capabilities.defines_lapH = false;
+  return m;
 }
 
 void GompperKroll::forces(const Topology& t, const Points& x, double kappa_b, Points& force) const {

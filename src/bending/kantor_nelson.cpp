@@ -10,12 +10,6 @@ namespace bendlab {
 
 namespace {
 
-bool parse_bool_option(const std::string& key, const std::string& value) {
-  if (value == "true" || value == "1" || value == "on" || value == "yes") return true;
-  if (value == "false" || value == "0" || value == "off" || value == "no") return false;
-  throw Error("method A: option '" + key + "' expects true or false, got '" + value + "'");
-}
-
 // theta / sin(theta) for theta in [0, pi), from s = sin(theta) >= 0 and theta. Below the
 // threshold the series 1 + theta^2/6 (next term 7 theta^4/360 < 1e-17) replaces the quotient,
 // so a flat edge (s = theta = 0) gives exactly 1 (footnote 1 of the paper).
@@ -37,14 +31,19 @@ struct Workspace {
 }  // namespace
 
 std::unique_ptr<BendingMethod> KantorNelson::create(const MethodOptions& options) {
-  bool small_angle = false;
-  for (const auto& [key, value] : options) {
-    if (key == "small_angle")
-      small_angle = parse_bool_option(key, value);
-    else
-      throw Error("method A: unknown option '" + key + "' (known: small_angle)");
-  }
-  return std::make_unique<KantorNelson>(small_angle);
+  const MethodOptions o = resolve_method_options(info(), options);
+  return std::make_unique<KantorNelson>(option_bool(o, "small_angle"));
+}
+
+MethodInfo KantorNelson::info() {
+  MethodInfo m{"A", "Kantor-Nelson: gradient of the dihedral-angle energy, eq. (6)",
+                {bool_option("small_angle", false, "small-angle form theta^2/2 of 1 - cos(theta)")}, {},
+                &KantorNelson::create};
+  m.capabilities.has_energy = true;
+  m.capabilities.defines_H = false;
+  m.capabilities.defines_K = false;
+  m.capabilities.defines_lapH = false;
+  return m;
 }
 
 // With c = n_f . n_g for the two faces f, g of an edge, eq. (6) is E_e = 2 kB~ (1 - c) and its

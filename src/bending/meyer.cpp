@@ -1,32 +1,19 @@
 #include "bendlab/bending/meyer.hpp"
 
+#include "bendlab/bending/variational_assembly.hpp"
 #include "bendlab/geometry/mesh_geometry.hpp"
 
 namespace bendlab {
 
-BendingResult assemble_variational_result(Points normal, Scalars H, Scalars K, Scalars lapH, Scalars area,
-                                          double kappa_b) {
-  const Eigen::Index n = H.size();
-  BendingResult r;
-  r.force_density.resize(n, 3);
-  r.force.resize(n, 3);
-  for (Eigen::Index i = 0; i < n; ++i) {
-    // eq. (10) with Lap = div grad (CONVENTIONS.md section 1).
-    const double fn = 2.0 * kappa_b * (lapH[i] + 2.0 * H[i] * (H[i] * H[i] - K[i]));
-    r.force_density.row(i) = fn * normal.row(i);
-    r.force.row(i) = area[i] * r.force_density.row(i);  // eq. (14)
-  }
-  r.normal = std::move(normal);
-  r.H = std::move(H);
-  r.K = std::move(K);
-  r.lapH = std::move(lapH);
-  r.area = std::move(area);
-  return r;
+std::unique_ptr<BendingMethod> MeyerMethod::create(const MethodOptions& options) {
+  resolve_method_options(info(), options);  // C takes no options: refuses any
+  return std::make_unique<MeyerMethod>();
 }
 
-std::unique_ptr<BendingMethod> MeyerMethod::create(const MethodOptions& options) {
-  if (!options.empty()) throw Error("method C: unknown option '" + options.begin()->first + "'");
-  return std::make_unique<MeyerMethod>();
+MethodInfo MeyerMethod::info() {
+  MethodInfo m{"C", "Meyer: cotangent Laplace-Beltrami operator in eq. (10), eqs. (11)-(12)",
+                {}, {}, &MeyerMethod::create};
+  return m;
 }
 
 BendingResult MeyerMethod::compute(const Topology& topology, const Points& x, double kappa_b) const {

@@ -2,7 +2,7 @@
 
 #include "bendlab/bending/belkin.hpp"
 #include "bendlab/bending/farutin.hpp"
-#include "bendlab/bending/meyer.hpp"
+#include "bendlab/bending/variational_assembly.hpp"
 #include "bendlab/geometry/mesh_geometry.hpp"
 
 namespace bendlab {
@@ -13,6 +13,13 @@ MixedEDMethod::MixedEDMethod(int rings) : rings_(rings) {
 
 std::unique_ptr<BendingMethod> MixedEDMethod::create(const MethodOptions& options) {
   return std::make_unique<MixedEDMethod>(parse_farutin_rings(options, "ED"));
+}
+
+MethodInfo MixedEDMethod::info() {
+  MethodInfo m{"ED", "E for n, H and K, D (heat kernel) for Lap H: the paper's conclusion",
+                {farutin_rings_option()}, {}, &MixedEDMethod::create};
+  m.capabilities.cost = std::string("O(N^2)");
+  return m;
 }
 
 BendingResult MixedEDMethod::compute(const Topology& topology, const Points& x, double kappa_b) const {

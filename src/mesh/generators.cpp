@@ -4,8 +4,9 @@
 #include <array>
 #include <cctype>
 #include <cmath>
-#include <numbers>
 #include <vector>
+
+#include "bendlab/mesh/subdivision.hpp"
 
 namespace bendlab {
 
@@ -31,26 +32,6 @@ namespace {
 
 void project_rows(Points& x, Eigen::Index first) {
   for (Eigen::Index i = first; i < x.rows(); ++i) x.row(i).normalize();
-}
-
-// Splits every face into four: corner triangles (a, m_ab, m_ca), (b, m_bc, m_ab), (c, m_ca, m_bc)
-// and the middle one (m_ab, m_bc, m_ca), all with the parent's orientation. The node on edge e is
-// num_vertices + e, so the new nodes follow the old ones in edge order.
-Faces split_in_four(const Topology& t) {
-  const int n = t.num_vertices();
-  const Faces& f = t.faces();
-  const Faces& fe = t.face_edges();
-  Faces out(4 * f.rows(), 3);
-  for (Eigen::Index i = 0; i < f.rows(); ++i) {
-    const int a = f(i, 0), b = f(i, 1), c = f(i, 2);
-    // face_edges(i, k) is opposite corner k.
-    const int m_bc = n + fe(i, 0), m_ca = n + fe(i, 1), m_ab = n + fe(i, 2);
-    out.row(4 * i + 0) << a, m_ab, m_ca;
-    out.row(4 * i + 1) << b, m_bc, m_ab;
-    out.row(4 * i + 2) << c, m_ca, m_bc;
-    out.row(4 * i + 3) << m_ab, m_bc, m_ca;
-  }
-  return out;
 }
 
 }  // namespace
@@ -81,39 +62,17 @@ TriMesh octahedron() {
 
 TriMesh refine_loop(const TriMesh& mesh, bool project_to_unit_sphere) {
   const Topology& t = mesh.topology();
-  const Points& x = mesh.positions();
-  const int n = t.num_vertices(), ne = t.num_edges();
-  Points y(n + ne, 3);
-  // Old vertices: (1 - n beta) v + beta sum(neighbours), Loop's beta.
-  for (int i = 0; i < n; ++i) {
-    const int d = t.valence(i);
-    const double c = 3.0 / 8.0 + std::cos(2.0 * std::numbers::pi / d) / 4.0;
-    const double beta = (5.0 / 8.0 - c * c) / d;
-    Vec3 sum = Vec3::Zero();
-    for (int k = t.ring_begin(i); k < t.ring_end(i); ++k) sum += row(x, t.ring_vertices()[k]);
-    y.row(i) = ((1.0 - d * beta) * row(x, i) + beta * sum).transpose();
-  }
-  // Edge points: 3/8 (a + b) + 1/8 (c + d), c and d the vertices opposite the edge.
-  const IndexPairs& ev = t.edge_vertices();
-  const IndexPairs& eo = t.edge_opposite();
-  for (int e = 0; e < ne; ++e) {
-    y.row(n + e) = 3.0 / 8.0 * (x.row(ev(e, 0)) + x.row(ev(e, 1))) + 1.0 / 8.0 * (x.row(eo(e, 0)) + x.row(eo(e, 1)));
-  }
+  Points y = loop_positions(t, mesh.positions());
   if (project_to_unit_sphere) project_rows(y, 0);
-  return TriMesh(std::move(y), split_in_four(t));
+  return TriMesh(split_in_four(t), std::move(y));
 }
 
 TriMesh refine_midpoint(const TriMesh& mesh, bool project_to_unit_sphere) {
   const Topology& t = mesh.topology();
-  const Points& x = mesh.positions();
-  const int n = t.num_vertices(), ne = t.num_edges();
-  Points y(n + ne, 3);
-  y.topRows(n) = x;
-  const IndexPairs& ev = t.edge_vertices();
-  for (int e = 0; e < ne; ++e) y.row(n + e) = 0.5 * (x.row(ev(e, 0)) + x.row(ev(e, 1)));
+  Points y = midpoint_positions(t, mesh.positions());
   // The old nodes are already on the sphere when the input is; only the new ones move.
-  if (project_to_unit_sphere) project_rows(y, n);
-  return TriMesh(std::move(y), split_in_four(t));
+  if (project_to_unit_sphere) project_rows(y, t.num_vertices());
+  return TriMesh(split_in_four(t), std::move(y));
 }
 
 namespace {

@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "bendlab/geometry/measures.hpp"
+#include "bendlab/mesh/enclosed_volume.hpp"
 
 namespace bendlab {
 

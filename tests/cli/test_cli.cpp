@@ -98,14 +98,73 @@ TEST_F(Cli, ShapeAndForcesWriteTheDocumentedColumns) {
   CliRun r = run("shape --mesh " + mesh.string() + " --shape rbc --out " + shape.string());
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(slurp(shape).rfind("x,y,z,nx,ny,nz,H,K,lapH,fx,fy,fz", 0), 0u);
-  for (const char* m : {"A", "B", "C", "D", "E", "ED"}) {
-    const fs::path forces = dir / (std::string("forces_") + m + ".csv");
+  const auto methods = nlohmann::json::parse(run("methods --json").out);
+  ASSERT_GE(methods.size(), 6u);
+  for (const auto& entry : methods) {
+    const std::string m = entry["name"];
+    const fs::path forces = dir / ("forces_" + m + ".csv");
     r = run("forces --mesh " + mesh.string() + " --method " + m + " --shape rbc --out " + forces.string());
     ASSERT_EQ(r.status, 0) << m << ": " << r.err;
     const std::string text = slurp(forces);
     EXPECT_EQ(text.rfind("x,y,z,nx,ny,nz,H,K,lapH,fx,fy,fz,Fx,Fy,Fz,area,", 0), 0u) << m;
     EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 163) << m;  // header + 162 vertices
   }
+}
+
+TEST_F(Cli, MethodsListsTheRegistryAsTableAndJson) {
+  const CliRun r = run("methods --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  std::vector<std::string> names;
+  for (const auto& m : j) {
+    names.push_back(m["name"]);
+    EXPECT_FALSE(m["description"].get<std::string>().empty());
+    EXPECT_TRUE(m["options"].is_array());
+    for (const char* key : {"has_energy", "defines_normal", "defines_H", "defines_K", "defines_lapH",
+                            "needs_admissible_mesh", "cost"})
+      EXPECT_TRUE(m["capabilities"].contains(key)) << key;
+  }
+  EXPECT_EQ(names, (std::vector<std::string>{"A", "B", "C", "D", "E", "ED"}));
+  EXPECT_TRUE(j[0]["capabilities"]["has_energy"].get<bool>());
+  EXPECT_FALSE(j[2]["capabilities"]["has_energy"].get<bool>());
+  EXPECT_EQ(j[3]["capabilities"]["cost"], "O(N^2)");
+  EXPECT_EQ(j[0]["options"][0]["name"], "small_angle");
+  EXPECT_EQ(j[0]["options"][0]["type"], "bool");
+  const auto& rings = j[4]["options"][0];
+  EXPECT_EQ(rings["name"], "rings");
+  EXPECT_EQ(rings["type"], "int");
+  EXPECT_EQ(rings["default"], "1");
+  EXPECT_EQ(rings["min"], 1);
+  EXPECT_EQ(rings["max"], 3);
+  EXPECT_EQ(j[5]["options"], j[4]["options"]);
+  // The table: one line per method (and per option), every name and description in it.
+  const CliRun t = run("methods");
+  ASSERT_EQ(t.status, 0) << t.err;
+  for (const auto& m : j) {
+    EXPECT_NE(t.out.find("\n" + m["name"].get<std::string>() + " "), std::string::npos) << t.out;
+    EXPECT_NE(t.out.find(m["description"].get<std::string>()), std::string::npos) << t.out;
+  }
+  EXPECT_NE(t.out.find("--option rings=1"), std::string::npos) << t.out;
+  // forces --help names every method.
+  const CliRun help = run("forces --help");
+  for (const auto& m : j) EXPECT_NE(help.out.find(m["description"].get<std::string>()), std::string::npos);
+}
+
+TEST_F(Cli, ForcesTakesMethodOptionsByName) {
+  const fs::path mesh = dir / "s.off";
+  ASSERT_EQ(run("mesh --family mt1 --level 1 --out " + mesh.string()).status, 0);
+  const fs::path a = dir / "a.csv", b = dir / "b.csv", out = dir / "c.csv";
+  ASSERT_EQ(run("forces --mesh " + mesh.string() + " --method E --rings 2 --out " + a.string()).status, 0);
+  ASSERT_EQ(run("forces --mesh " + mesh.string() + " --method E --option rings=2 --out " + b.string()).status, 0);
+  EXPECT_EQ(slurp(a), slurp(b));
+  expect_refused(run("forces --mesh " + mesh.string() + " --method E --option rings=4 --out " + out.string()),
+                 "rings", out);
+  expect_refused(run("forces --mesh " + mesh.string() + " --method C --option bogus=1 --out " + out.string()),
+                 "'bogus'", out);
+  expect_refused(run("forces --mesh " + mesh.string() + " --method E --rings 2 --option rings=3 --out " +
+                     out.string()), "twice", out);
+  expect_refused(run("forces --mesh " + mesh.string() + " --method E --option rings --out " + out.string()),
+                 "key=value", out);
 }
 
 TEST_F(Cli, RefusesBadMeshesWithOneLineNamingTheProblem) {

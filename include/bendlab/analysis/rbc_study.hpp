@@ -18,7 +18,7 @@
 
 #include "bendlab/analysis/convergence.hpp"
 #include "bendlab/analysis/error_measures.hpp"
-#include "bendlab/bending/bending_method.hpp"
+#include "bendlab/bending/method_registry.hpp"
 #include "bendlab/mesh/trimesh.hpp"
 #include "bendlab/surfaces/analytic_surface.hpp"
 
@@ -26,9 +26,10 @@ namespace bendlab {
 
 struct RbcStudyOptions {
   std::vector<std::string> families = {"mt1", "mt2", "octa", "inhomogeneous"};
-  std::vector<std::string> methods = {"A", "B", "C", "D", "E", "ED"};
-  /// Options of the fitting methods (e.g. {"rings", "2"}): passed to E and ED; the other methods
-  /// take none.
+  /// Every registered method by default (method_registry.hpp), in the registry's order.
+  std::vector<std::string> methods = bending_method_names();
+  /// Method options (e.g. {"rings", "2"}), each passed to the methods whose schema has it (rings:
+  /// E and ED); an option that no registered method takes is an error.
   MethodOptions method_options;
   int max_triangles = 5120;
   double kappa_b = 1.0;

@@ -22,7 +22,7 @@
 #include <memory>
 #include <vector>
 
-#include "bendlab/bending/bending_method.hpp"
+#include "bendlab/bending/method_registry.hpp"
 #include "bendlab/geometry/mesh_geometry.hpp"
 
 namespace bendlab {
@@ -75,6 +75,8 @@ class BelkinMethod final : public BendingMethod {
   explicit BelkinMethod(BelkinOptions options = {}) : options_(options) {}
   /// Method D has no options yet; any option is an error (bendlab::Error naming it).
   static std::unique_ptr<BendingMethod> create(const MethodOptions& options);
+  /// The method's entry in the registry (method_registry.hpp): description, options, capabilities.
+  static MethodInfo info();
 
   std::string name() const override { return "D"; }
   BendingResult compute(const Topology& topology, const Points& x, double kappa_b) const override;

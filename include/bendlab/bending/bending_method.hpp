@@ -45,8 +45,10 @@ class BendingMethod {
   virtual std::optional<double> energy(const Topology&, const Points&, double) const { return std::nullopt; }
 };
 
-/// Creates a method by name ("A".."E", "ED"), with its options. Throws bendlab::Error for an
-/// unknown name or option.
+/// Creates a method by name ("A".."E", "ED", or any method registered since), with its options,
+/// through the method table (method_registry.hpp): the options are checked against the method's
+/// schema and completed with the defaults. Throws bendlab::Error for an unknown name (listing the
+/// known ones) or an option the schema refuses (naming the method and the option).
 std::unique_ptr<BendingMethod> make_bending_method(const std::string& name, const MethodOptions& options = {});
 
 }  // namespace bendlab

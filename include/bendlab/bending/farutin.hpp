@@ -24,7 +24,7 @@
 #include <span>
 #include <vector>
 
-#include "bendlab/bending/bending_method.hpp"
+#include "bendlab/bending/method_registry.hpp"
 #include "bendlab/core/types.hpp"
 #include "bendlab/geometry/mesh_geometry.hpp"
 #include "bendlab/mesh/topology.hpp"
@@ -73,6 +73,8 @@ struct FarutinFields {
 };
 FarutinFields farutin_fields(const std::vector<FarutinFit>& fits);
 
+/// The schema of the option "rings" (integer 1..3, default 1), shared by Methods E and ED.
+OptionSpec farutin_rings_option();
 /// Reads the option "rings" (1, 2 or 3; default 1); throws bendlab::Error for any other option or
 /// value. Shared by Methods E and ED.
 int parse_farutin_rings(const MethodOptions& options, const std::string& method);
@@ -82,6 +84,8 @@ class FarutinMethod : public BendingMethod {
  public:
   explicit FarutinMethod(int rings = 1);
   static std::unique_ptr<BendingMethod> create(const MethodOptions& options);
+  /// The method's entry in the registry (method_registry.hpp): description, options, capabilities.
+  static MethodInfo info();
 
   std::string name() const override { return "E"; }
   BendingResult compute(const Topology& topology, const Points& x, double kappa_b) const override;

@@ -16,7 +16,7 @@
 // K = angle defect / mixed area (eq. (12)); lapH is not defined by the method and is NaN.
 #include <memory>
 
-#include "bendlab/bending/bending_method.hpp"
+#include "bendlab/bending/method_registry.hpp"
 
 namespace bendlab {
 
@@ -25,6 +25,8 @@ class GompperKroll : public BendingMethod {
   GompperKroll() = default;
   /// Method B has no options; throws bendlab::Error for any option given.
   static std::unique_ptr<BendingMethod> create(const MethodOptions& options);
+  /// The method's entry in the registry (method_registry.hpp): description, options, capabilities.
+  static MethodInfo info();
 
   std::string name() const override { return "B"; }
 

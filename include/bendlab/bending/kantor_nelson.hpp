@@ -19,7 +19,7 @@
 // the method and are NaN.
 #include <memory>
 
-#include "bendlab/bending/bending_method.hpp"
+#include "bendlab/bending/method_registry.hpp"
 
 namespace bendlab {
 
@@ -28,6 +28,8 @@ class KantorNelson : public BendingMethod {
   explicit KantorNelson(bool small_angle = false) : small_angle_(small_angle) {}
   /// Options: "small_angle" = true|false|1|0. Throws bendlab::Error on any other option or value.
   static std::unique_ptr<BendingMethod> create(const MethodOptions& options);
+  /// The method's entry in the registry (method_registry.hpp): description, options, capabilities.
+  static MethodInfo info();
 
   std::string name() const override { return "A"; }
   bool small_angle() const { return small_angle_; }

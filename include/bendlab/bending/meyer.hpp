@@ -10,23 +10,20 @@
 //   f_i          : eq. (10), f = 2 kB (lapH + 2 H (H^2 - K)) n (CONVENTIONS.md sign);
 //   F_i          : f_i A_mixed_i, eq. (14); area = A_mixed.
 // The paper writes eq. (11) as sum T_ij (w_i - w_j); here the Laplacian is div grad
-// (sum T_ij (w_j - w_i)), the sign with which eq. (10) holds. Method C has no energy.
+// (sum T_ij (w_j - w_i)), the sign with which eq. (10) holds. Method C has no energy. The last step,
+// eqs. (10) and (14), is assemble_variational_result (variational_assembly.hpp), shared with D, E, ED.
 #include <memory>
 
-#include "bendlab/bending/bending_method.hpp"
+#include "bendlab/bending/method_registry.hpp"
 
 namespace bendlab {
-
-/// Assembles the result of a variational method (C, D, E, ...) from its per-vertex normal, H, K
-/// and lapH: f by eq. (10) with the CONVENTIONS.md sign, F = f * area by eq. (14). `area` is the
-/// mixed area. Moves the inputs into the result; energy stays empty.
-BendingResult assemble_variational_result(Points normal, Scalars H, Scalars K, Scalars lapH, Scalars area,
-                                          double kappa_b);
 
 class MeyerMethod final : public BendingMethod {
  public:
   /// Method C has no options; any option is an error (bendlab::Error naming it).
   static std::unique_ptr<BendingMethod> create(const MethodOptions& options);
+  /// The method's entry in the registry (method_registry.hpp): description, options, capabilities.
+  static MethodInfo info();
 
   std::string name() const override { return "C"; }
   BendingResult compute(const Topology& topology, const Points& x, double kappa_b) const override;

@@ -6,7 +6,7 @@
 // F = f A_mixed, eq. (14). Cost O(N^2), like Method D.
 #include <memory>
 
-#include "bendlab/bending/bending_method.hpp"
+#include "bendlab/bending/method_registry.hpp"
 
 namespace bendlab {
 
@@ -16,6 +16,8 @@ class MixedEDMethod : public BendingMethod {
   explicit MixedEDMethod(int rings = 1);
   /// Option "rings" (1, 2, 3; default 1); throws bendlab::Error for any other option or value.
   static std::unique_ptr<BendingMethod> create(const MethodOptions& options);
+  /// The method's entry in the registry (method_registry.hpp): description, options, capabilities.
+  static MethodInfo info();
 
   std::string name() const override { return "ED"; }
   BendingResult compute(const Topology& topology, const Points& x, double kappa_b) const override;

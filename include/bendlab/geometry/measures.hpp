@@ -1,12 +1,12 @@
 #pragma once
-// Global measures of a closed triangle mesh (flat triangles).
+// Global measures of a closed triangle mesh (flat triangles). The enclosed volume lives with the
+// mesh (bendlab/mesh/enclosed_volume.hpp, included here), which needs it to check orientation.
 #include "bendlab/core/types.hpp"
+#include "bendlab/mesh/enclosed_volume.hpp"  // enclosed_volume()
 #include "bendlab/mesh/topology.hpp"
 
 namespace bendlab {
 
-/// Enclosed volume by the divergence theorem, (1/6) sum_f x0 . (x1 x x2): positive for outward faces.
-double enclosed_volume(const Topology& topology, const Points& x);
 /// Total area of the flat triangles.
 double surface_area(const Topology& topology, const Points& x);
 /// Centroid of the enclosed volume (not of the nodes), from surface integrals.

@@ -25,7 +25,8 @@ TriMesh icosahedron();
 /// Regular octahedron (6 vertices, 8 faces) with its vertices on the unit sphere.
 TriMesh octahedron();
 
-/// One Loop subdivision step (each triangle -> 4). New edge point: 3/8 (a + b) + 1/8 (c + d);
+/// One Loop subdivision step (each triangle -> 4; topology, numbering and stencil in
+/// subdivision.hpp). New edge point: 3/8 (a + b) + 1/8 (c + d);
 /// old vertex of valence n: (1 - n beta) v + beta sum(neighbours), Loop's
 /// beta = (5/8 - (3/8 + cos(2 pi / n) / 4)^2) / n. With project, every node is then moved
 /// radially onto the unit sphere.
