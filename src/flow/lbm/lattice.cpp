@@ -6,57 +6,140 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <utility>
 
 namespace bendlab::lbm {
 
 namespace {
 
+// Everything inside the row loop must be inlined for it to vectorise.
+#if defined(__GNUC__)
+#define LBM_INLINE [[gnu::always_inline]] inline
+#else
+#define LBM_INLINE inline
+#endif
+
+// The collisions are written as straight-line code over the 19 directions (index_sequence), with
+// the velocity components folded in at compile time, so that the loop over a row vectorises
+// across nodes: no multiplication by a zero velocity component remains (the compiler may not drop
+// 0 * x or x + 0 under IEEE semantics).
+template <int C>
+LBM_INLINE double term(double v) {
+  if constexpr (C == 1) {
+    return v;
+  } else if constexpr (C == -1) {
+    return -v;
+  } else {
+    return 0.0;
+  }
+}
+// c . (a, b, c) for a D3Q19 velocity (at most two non-zero components).
+template <int X, int Y, int Z>
+LBM_INLINE double cdot(double a, double b, double c) {
+  if constexpr (X != 0 && Y != 0) {
+    return term<X>(a) + term<Y>(b);
+  } else if constexpr (X != 0 && Z != 0) {
+    return term<X>(a) + term<Z>(c);
+  } else if constexpr (Y != 0 && Z != 0) {
+    return term<Y>(b) + term<Z>(c);
+  } else if constexpr (X != 0) {
+    return term<X>(a);
+  } else if constexpr (Y != 0) {
+    return term<Y>(b);
+  } else if constexpr (Z != 0) {
+    return term<Z>(c);
+  } else {
+    return 0.0;
+  }
+}
+// c . S . c for a symmetric S.
+template <int X, int Y, int Z>
+LBM_INLINE double csc(double sxx, double syy, double szz, double sxy, double sxz, double syz) {
+  if constexpr (X != 0 && Y != 0) {
+    return sxx + syy + term<X * Y>(2.0 * sxy);
+  } else if constexpr (X != 0 && Z != 0) {
+    return sxx + szz + term<X * Z>(2.0 * sxz);
+  } else if constexpr (Y != 0 && Z != 0) {
+    return syy + szz + term<Y * Z>(2.0 * syz);
+  } else if constexpr (X != 0) {
+    return sxx;
+  } else if constexpr (Y != 0) {
+    return syy;
+  } else if constexpr (Z != 0) {
+    return szz;
+  } else {
+    return 0.0;
+  }
+}
+// sum_q c_q f_q along one axis: only the directions with a non-zero component.
+template <const std::array<int, kQ>& C, std::size_t... Q>
+LBM_INLINE double moment(const double* f, std::index_sequence<Q...>) {
+  double s = 0.0;
+  ((C[Q] == 1 ? (s += f[Q]) : (C[Q] == -1 ? (s -= f[Q]) : s)), ...);
+  return s;
+}
+template <std::size_t... Q>
+LBM_INLINE double sum(const double* f, std::index_sequence<Q...>) {
+  return (f[Q] + ...);
+}
+// sum_q c_qa c_qb f_q for a != b.
+template <const std::array<int, kQ>& A, const std::array<int, kQ>& B, std::size_t... Q>
+LBM_INLINE double cross_moment(const double* f, std::index_sequence<Q...>) {
+  double s = 0.0;
+  ((A[Q] * B[Q] == 1 ? (s += f[Q]) : (A[Q] * B[Q] == -1 ? (s -= f[Q]) : s)), ...);
+  return s;
+}
+// sum_q c_qa^2 f_q.
+template <const std::array<int, kQ>& A, std::size_t... Q>
+LBM_INLINE double square_moment(const double* f, std::index_sequence<Q...>) {
+  double s = 0.0;
+  ((A[Q] != 0 ? (s += f[Q]) : s), ...);
+  return s;
+}
+using Directions = std::make_index_sequence<kQ>;
+
 // BGK + Guo (technical note section 1), omega = 1/tau, a = 1 - 1/(2 tau).
 struct Bgk {
   double omega, a;
-  inline void operator()(double* f, double Fx, double Fy, double Fz) const {
-    double rho = 0, jx = 0, jy = 0, jz = 0;
-#pragma GCC unroll 19
-    for (int q = 0; q < kQ; ++q) {
-      rho += f[q];
-      jx += kCx[q] * f[q];
-      jy += kCy[q] * f[q];
-      jz += kCz[q] * f[q];
-    }
+  template <std::size_t Q>
+  LBM_INLINE void relax(double* f, double rho, double ux, double uy, double uz, double uu, double uF,
+                    double Fx, double Fy, double Fz) const {
+    constexpr int X = kCx[Q], Y = kCy[Q], Z = kCz[Q];
+    const double cu = cdot<X, Y, Z>(ux, uy, uz);
+    const double cF = cdot<X, Y, Z>(Fx, Fy, Fz);
+    const double feq = kW[Q] * rho * (1.0 + 3.0 * cu + 4.5 * cu * cu - 1.5 * uu);
+    const double guo = kW[Q] * (3.0 * (cF - uF) + 9.0 * cu * cF);
+    f[Q] = f[Q] - omega * (f[Q] - feq) + a * guo;
+  }
+  template <std::size_t... Q>
+  LBM_INLINE void apply(double* f, double Fx, double Fy, double Fz, std::index_sequence<Q...> d) const {
+    const double rho = sum(f, d);
+    const double jx = moment<kCx>(f, d), jy = moment<kCy>(f, d), jz = moment<kCz>(f, d);
     const double ir = 1.0 / rho;
     const double ux = (jx + 0.5 * Fx) * ir, uy = (jy + 0.5 * Fy) * ir, uz = (jz + 0.5 * Fz) * ir;
     const double uu = ux * ux + uy * uy + uz * uz, uF = ux * Fx + uy * Fy + uz * Fz;
-#pragma GCC unroll 19
-    for (int q = 0; q < kQ; ++q) {
-      const double cu = kCx[q] * ux + kCy[q] * uy + kCz[q] * uz;
-      const double cF = kCx[q] * Fx + kCy[q] * Fy + kCz[q] * Fz;
-      const double feq = kW[q] * rho * (1.0 + 3.0 * cu + 4.5 * cu * cu - 1.5 * uu);
-      const double guo = kW[q] * (3.0 * (cF - uF) + 9.0 * cu * cF);
-      f[q] = f[q] - omega * (f[q] - feq) + a * guo;
-    }
+    (relax<Q>(f, rho, ux, uy, uz, uu, uF, Fx, Fy, Fz), ...);
   }
+  LBM_INLINE void operator()(double* f, double Fx, double Fy, double Fz) const { apply(f, Fx, Fy, Fz, Directions{}); }
 };
 
 // ESPResSo's MRT with default bulk and ghost relaxation as a regularised scheme (section 1):
 // gs = 1 - 1/tau relaxes the traceless non-equilibrium stress, the trace is dropped, as = 1 - 1/(2 tau).
 struct Regularized {
   double gs, as;
-  inline void operator()(double* f, double Fx, double Fy, double Fz) const {
-    double rho = 0, jx = 0, jy = 0, jz = 0, pxx = 0, pyy = 0, pzz = 0, pxy = 0, pxz = 0, pyz = 0;
-#pragma GCC unroll 19
-    for (int q = 0; q < kQ; ++q) {
-      const double v = f[q];
-      rho += v;
-      jx += kCx[q] * v;
-      jy += kCy[q] * v;
-      jz += kCz[q] * v;
-      pxx += kCx[q] * kCx[q] * v;
-      pyy += kCy[q] * kCy[q] * v;
-      pzz += kCz[q] * kCz[q] * v;
-      pxy += kCx[q] * kCy[q] * v;
-      pxz += kCx[q] * kCz[q] * v;
-      pyz += kCy[q] * kCz[q] * v;
-    }
+  template <std::size_t Q>
+  LBM_INLINE static void rebuild(double* f, double rho, double jsx, double jsy, double jsz, double sxx, double syy,
+                             double szz, double sxy, double sxz, double syz, double trs) {
+    constexpr int X = kCx[Q], Y = kCy[Q], Z = kCz[Q];
+    const double ss = csc<X, Y, Z>(sxx, syy, szz, sxy, sxz, syz) - trs;
+    f[Q] = kW[Q] * (rho + 3.0 * cdot<X, Y, Z>(jsx, jsy, jsz) + 4.5 * ss);
+  }
+  template <std::size_t... Q>
+  LBM_INLINE void apply(double* f, double Fx, double Fy, double Fz, std::index_sequence<Q...> d) const {
+    const double rho = sum(f, d);
+    const double jx = moment<kCx>(f, d), jy = moment<kCy>(f, d), jz = moment<kCz>(f, d);
+    const double pxx = square_moment<kCx>(f, d), pyy = square_moment<kCy>(f, d), pzz = square_moment<kCz>(f, d);
+    const double pxy = cross_moment<kCx, kCy>(f, d), pxz = cross_moment<kCx, kCz>(f, d), pyz = cross_moment<kCy, kCz>(f, d);
     const double ir = 1.0 / rho;
     const double ux = (jx + 0.5 * Fx) * ir, uy = (jy + 0.5 * Fy) * ir, uz = (jz + 0.5 * Fz) * ir;
     const double r3 = rho / 3.0;
@@ -73,15 +156,9 @@ struct Regularized {
     const double sxz = rho * ux * uz + gs * nxz + as * (ux * Fz + uz * Fx);
     const double syz = rho * uy * uz + gs * nyz + as * (uy * Fz + uz * Fy);
     const double trs = (sxx + syy + szz) / 3.0;
-    const double jsx = jx + Fx, jsy = jy + Fy, jsz = jz + Fz;
-#pragma GCC unroll 19
-    for (int q = 0; q < kQ; ++q) {
-      const double cx = kCx[q], cy = kCy[q], cz = kCz[q];
-      const double ss = sxx * cx * cx + syy * cy * cy + szz * cz * cz +
-                        2.0 * (sxy * cx * cy + sxz * cx * cz + syz * cy * cz) - trs;
-      f[q] = kW[q] * (rho + 3.0 * (cx * jsx + cy * jsy + cz * jsz) + 4.5 * ss);
-    }
+    (rebuild<Q>(f, rho, jx + Fx, jy + Fy, jz + Fz, sxx, syy, szz, sxy, sxz, syz, trs), ...);
   }
+  LBM_INLINE void operator()(double* f, double Fx, double Fy, double Fz) const { apply(f, Fx, Fy, Fz, Directions{}); }
 };
 
 constexpr std::size_t kParallelNodes = std::size_t{1} << 15;
@@ -104,42 +181,38 @@ struct RowPlan {
   double radd[kQ], wadd[kQ];
 };
 
-inline int wrap(int i, int n) { return ((i % n) + n) % n; }
+LBM_INLINE int wrap(int i, int n) { return ((i % n) + n) % n; }
 
-template <bool kAdd, class Coll>
-inline void row_kernel(const RowPlan& p, const double* __restrict Fx, const double* __restrict Fy,
-                       const double* __restrict Fz, int x0, int x1, const Coll& coll) {
-  const double* r[kQ];
-  double* w[kQ];
-  for (int q = 0; q < kQ; ++q) {
-    r[q] = p.rbase[q] + (p.roff[q] + x0);
-    w[q] = p.wbase[q] + (p.woff[q] + x0);
-  }
+template <bool kAdd, class Coll, std::size_t... Q>
+LBM_INLINE void row_kernel_impl(const RowPlan& p, const double* __restrict Fx, const double* __restrict Fy,
+                            const double* __restrict Fz, int x0, int x1, const Coll& coll, std::index_sequence<Q...>) {
+  const double* r[kQ] = {(p.rbase[Q] + (p.roff[Q] + x0))...};
+  double* w[kQ] = {(p.wbase[Q] + (p.woff[Q] + x0))...};
   const double* fx = Fx + x0;
   const double* fy = Fy + x0;
   const double* fz = Fz + x0;
   const int n = x1 - x0;
-#pragma omp simd
+  // Each node reads and writes its own 19 locations (AA pattern): the iterations are independent.
+#pragma GCC ivdep
   for (int x = 0; x < n; ++x) {
     double f[kQ];
-#pragma GCC unroll 19
-    for (int q = 0; q < kQ; ++q) {
-      if constexpr (kAdd) {
-        f[q] = r[q][x] + p.radd[q];
-      } else {
-        f[q] = r[q][x];
-      }
+    if constexpr (kAdd) {
+      ((f[Q] = r[Q][x] + p.radd[Q]), ...);
+    } else {
+      ((f[Q] = r[Q][x]), ...);
     }
     coll(f, fx[x], fy[x], fz[x]);
-#pragma GCC unroll 19
-    for (int q = 0; q < kQ; ++q) {
-      if constexpr (kAdd) {
-        w[q][x] = f[q] + p.wadd[q];
-      } else {
-        w[q][x] = f[q];
-      }
+    if constexpr (kAdd) {
+      ((w[Q][x] = f[Q] + p.wadd[Q]), ...);
+    } else {
+      ((w[Q][x] = f[Q]), ...);
     }
   }
+}
+
+template <bool kAdd, class Coll>
+LBM_INLINE void row_kernel(const RowPlan& p, const double* Fx, const double* Fy, const double* Fz, int x0, int x1, const Coll& coll) {
+  row_kernel_impl<kAdd>(p, Fx, Fy, Fz, x0, x1, coll, Directions{});
 }
 
 // The odd (streaming) step's plan for row (j, k): xe < 0 gives the offsets of the interior nodes
@@ -189,7 +262,7 @@ bool odd_plan(const StepArgs& a, int j, int k, int xe, RowPlan& p) {
 }
 
 template <class Coll>
-inline void process_rows_impl(const StepArgs& a, int row0, int row1, const Coll& coll) {
+LBM_INLINE void process_rows_impl(const StepArgs& a, int row0, int row1, const Coll& coll) {
   RowPlan p;
   for (int r = row0; r < row1; ++r) {
     const int j = r % a.ny, k = r / a.ny;
@@ -227,7 +300,7 @@ inline void process_rows_impl(const StepArgs& a, int row0, int row1, const Coll&
 
 // The row loops, compiled for AVX-512, AVX2 and the baseline and chosen when the program starts.
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-#define BENDLAB_LBM_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
+#define BENDLAB_LBM_CLONES __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
 #else
 #define BENDLAB_LBM_CLONES
 #endif
