@@ -27,6 +27,7 @@
 // in both steps, so each update moves 19 + 19 doubles plus the 3 force components: 328 bytes per
 // node update (no write-allocate traffic, no second lattice). Which slot holds which population
 // therefore depends on the parity of the step; populations() hides it.
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
