@@ -1,0 +1,149 @@
+// The lattice Boltzmann fluid step (D3Q19, AA pattern, structure of arrays) against the memory
+// bandwidth of the same machine, measured in the same program.
+//   ./build/release/bench_lbm
+//
+// Benchmarks (last argument: OpenMP threads):
+//   BM_StreamCopy, BM_StreamTriad  STREAM-like a = b and a = b + s c over 2^24 doubles per array.
+//                  bytes_per_second counts STREAM's bytes (16 and 24 per element); the counter
+//                  traffic_GBps adds the write-allocate line fill of the target (24 and 32 bytes),
+//                  the traffic the memory actually sees.
+//   BM_LbmStep/<collision>  one step of a 128^3 box between moving walls (shear flow, force field
+//                  read but zero). MLUPS = node updates per microsecond; GBps = MLUPS x 328 bytes
+//                  (19 + 19 doubles of populations and 3 force components per node update; the AA
+//                  pattern writes back to the lines it read, so no write-allocate traffic);
+//                  bound_fraction = GBps / (the triad's traffic_GBps on as many threads), the
+//                  fraction of the bandwidth bound of this layout that the kernel reaches.
+#include <benchmark/benchmark.h>
+#include <omp.h>
+
+#include <algorithm>
+#include <map>
+#include <memory>
+#include <vector>
+
+#include "bendlab/flow/lbm/lattice.hpp"
+
+using namespace bendlab;
+using namespace bendlab::lbm;
+
+namespace {
+
+constexpr std::size_t kStreamN = std::size_t{1} << 24;
+constexpr double kBytesPerUpdate = 328.0;
+std::map<int, double> triad_traffic;  // threads -> GB/s including write-allocate
+
+struct StreamArrays {
+  std::vector<double> a, b, c;
+  StreamArrays() : a(kStreamN), b(kStreamN), c(kStreamN) {
+    const auto n = static_cast<std::int64_t>(kStreamN);
+#pragma omp parallel for schedule(static)
+    for (std::int64_t i = 0; i < n; ++i) {  // first touch by the threads that use them
+      a[i] = 0.0;
+      b[i] = 1.0;
+      c[i] = 2.0;
+    }
+  }
+};
+StreamArrays& stream_arrays() {
+  static StreamArrays s;
+  return s;
+}
+
+void BM_StreamCopy(benchmark::State& state) {
+  omp_set_num_threads(static_cast<int>(state.range(0)));
+  auto& s = stream_arrays();
+  double* a = s.a.data();
+  const double* b = s.b.data();
+  const auto n = static_cast<std::int64_t>(kStreamN);
+  for (auto _ : state) {
+#pragma omp parallel for schedule(static)
+    for (std::int64_t i = 0; i < n; ++i) a[i] = b[i];
+    benchmark::ClobberMemory();
+  }
+  state.SetBytesProcessed(state.iterations() * static_cast<std::int64_t>(16 * kStreamN));
+  state.counters["traffic_GBps"] = benchmark::Counter(static_cast<double>(state.iterations()) * 24.0 * kStreamN * 1e-9, benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_StreamCopy)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
+
+void BM_StreamTriad(benchmark::State& state) {
+  const int threads = static_cast<int>(state.range(0));
+  omp_set_num_threads(threads);
+  auto& s = stream_arrays();
+  double* a = s.a.data();
+  const double* b = s.b.data();
+  const double* c = s.c.data();
+  const auto n = static_cast<std::int64_t>(kStreamN);
+  const double scalar = 3.0;
+  for (auto _ : state) {
+#pragma omp parallel for schedule(static)
+    for (std::int64_t i = 0; i < n; ++i) a[i] = b[i] + scalar * c[i];
+    benchmark::ClobberMemory();
+  }
+  state.SetBytesProcessed(state.iterations() * static_cast<std::int64_t>(24 * kStreamN));
+  state.counters["traffic_GBps"] = benchmark::Counter(static_cast<double>(state.iterations()) * 32.0 * kStreamN * 1e-9, benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_StreamTriad)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
+
+Lattice& shear_box(Collision collision) {
+  static std::map<Collision, std::unique_ptr<Lattice>> cache;
+  auto& L = cache[collision];
+  if (!L) {
+    cache.clear();  // one 128^3 lattice (about 370 MB) at a time
+    LatticeConfig c;
+    c.nx = c.ny = c.nz = 128;
+    c.tau = collision == Collision::BGK ? 1.0 : 0.8;
+    c.collision = collision;
+    c.wall_velocity = 0.01;
+    cache[collision] = std::make_unique<Lattice>(c);
+    cache[collision]->initialise_shear_flow();
+    return *cache[collision];
+  }
+  return *L;
+}
+
+void lbm_step(benchmark::State& state, Collision collision) {
+  const int threads = static_cast<int>(state.range(0));
+  omp_set_num_threads(threads);
+  Lattice& L = shear_box(collision);
+  L.run(2);  // warm up both parities
+  for (auto _ : state) L.step();
+  const double updates = static_cast<double>(state.iterations()) * static_cast<double>(L.num_nodes());
+  state.counters["MLUPS"] = benchmark::Counter(updates * 1e-6, benchmark::Counter::kIsRate);
+  state.counters["GBps"] = benchmark::Counter(updates * kBytesPerUpdate * 1e-9, benchmark::Counter::kIsRate);
+  // Filled in by the triad run on as many threads (registered, hence run, before this one).
+  if (triad_traffic.count(threads) && state.iterations() > 0) {
+    state.counters["bound_fraction"] = benchmark::Counter(updates * kBytesPerUpdate * 1e-9 / triad_traffic[threads], benchmark::Counter::kIsRate);
+  }
+}
+void BM_LbmStepBGK(benchmark::State& state) { lbm_step(state, Collision::BGK); }
+void BM_LbmStepRegularized(benchmark::State& state) { lbm_step(state, Collision::Regularized); }
+
+// Measures the triad once per thread count for bound_fraction (not reported by itself).
+void BM_TriadReference(benchmark::State& state) {
+  const int threads = static_cast<int>(state.range(0));
+  omp_set_num_threads(threads);
+  auto& s = stream_arrays();
+  double* a = s.a.data();
+  const double* b = s.b.data();
+  const double* c = s.c.data();
+  const auto n = static_cast<std::int64_t>(kStreamN);
+  double best = 0;
+  for (auto _ : state) {
+    for (int rep = 0; rep < 5; ++rep) {
+      const double t0 = omp_get_wtime();
+#pragma omp parallel for schedule(static)
+      for (std::int64_t i = 0; i < n; ++i) a[i] = b[i] + 3.0 * c[i];
+      benchmark::ClobberMemory();
+      best = std::max(best, 32.0 * kStreamN * 1e-9 / (omp_get_wtime() - t0));
+    }
+  }
+  triad_traffic[threads] = best;
+  state.counters["best_traffic_GBps"] = best;
+}
+BENCHMARK(BM_TriadReference)->Arg(1)->Arg(2)->Iterations(1)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_LbmStepBGK)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_LbmStepRegularized)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();

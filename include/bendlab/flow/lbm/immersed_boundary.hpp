@@ -1,0 +1,57 @@
+#pragma once
+// Immersed-boundary coupling of membrane nodes to the lattice (paper section 4.3.2, after Krueger;
+// technical note shared/spec/LBM_IBM.md section 3). Node positions X are physical coordinates
+// (box centred on the origin, Lattice::position); with dx = 1 a node force spread onto the lattice
+// is a force density.
+//   spread:       F(x) += sum_k F_k Phi(x - X_k)
+//   interpolate:  U_k = sum_x u(x) Phi(x - X_k), u with the +F/2 correction (Lattice::velocity)
+//   move:         X_k <- X_k + U_k dt (explicit Euler)
+// Phi(r) = phi(r_x) phi(r_y) phi(r_z) with one of the 1-D kernels below; the support is periodic in
+// x and y (and in z for a box without walls). With walls, a node whose support reaches past a
+// wall is an error.
+//
+// One step in ESPResSo's order (ib_step): (1) the caller computes the membrane forces at X(t);
+// (2) clear the lattice force and spread them; (3) collide with Guo forcing, stream, bounce back;
+// (4) interpolate from the post-stream populations with +F/2 of the same force and move the nodes.
+#include <array>
+#include <cstddef>
+
+#include "bendlab/core/types.hpp"
+#include "bendlab/flow/lbm/lattice.hpp"
+
+namespace bendlab::lbm {
+
+enum class IbKernel {
+  Phi2,  ///< linear hat 1 - |r| (|r| <= 1), 2 nodes per axis: ESPResSo's trilinear weights (default)
+  Phi3,  ///< Roma-Peskin 3-point kernel (|r| <= 3/2)
+  Phi4,  ///< Peskin 4-point cosine-free kernel (|r| <= 2)
+};
+
+/// phi(r), zero outside the support.
+double ib_kernel(IbKernel kernel, double r);
+/// Half-width of the support in dx: 1, 1.5, 2.
+double ib_kernel_half_width(IbKernel kernel);
+
+/// The lattice nodes and weights Phi(x - X) of one position (at most 4^3 nodes; nodes repeat if
+/// the box is narrower than the support).
+struct IbStencil {
+  int size = 0;
+  std::array<std::size_t, 64> node{};
+  std::array<double, 64> weight{};
+};
+/// Throws bendlab::Error if X is not finite or its support crosses a wall.
+IbStencil ib_stencil(const Lattice& lattice, const Vec3& X, IbKernel kernel);
+
+/// Adds sum_k F_k Phi(x - X_k) to the lattice force field (X, F: N x 3).
+void spread_forces(Lattice& lattice, const Points& X, const Points& F, IbKernel kernel = IbKernel::Phi2);
+/// U (resized to N x 3) = sum_x u(x) Phi(x - X_k), u = (sum f c + F/2) / rho.
+void interpolate_velocity(const Lattice& lattice, const Points& X, Points& U, IbKernel kernel = IbKernel::Phi2);
+/// X <- X + dt U.
+void euler_move(Points& X, const Points& U, double dt = 1.0);
+
+/// Steps (2)-(4) above for node forces F computed by the caller at the current X: clears the
+/// lattice force, spreads F, advances the fluid one step, interpolates the node velocities into U
+/// and moves X by U (dt = 1).
+void ib_step(Lattice& lattice, Points& X, const Points& F, Points& U, IbKernel kernel = IbKernel::Phi2);
+
+}  // namespace bendlab::lbm

@@ -1,0 +1,141 @@
+#pragma once
+// D3Q19 lattice Boltzmann fluid for the immersed-boundary capsule solver (paper section 4.3.2;
+// technical note shared/spec/LBM_IBM.md sections 1-2). Lattice units dx = dt = 1, rho0 = 1.
+//
+// Collision: BGK with Guo forcing,
+//   f_i* = f_i - (f_i - f_i^eq(rho, u)) / tau + (1 - 1/(2 tau)) w_i [3 (c_i - u) + 9 (c_i.u) c_i].F,
+// which is ESPResSo's MRT scheme exactly at tau = 1 (default bulk and ghost relaxation), and for
+// tau != 1 the regularised form that equals ESPResSo's MRT: from rho, j = sum f c and
+// Pi = sum f c c, relax the traceless part of Pi - Pi^eq by 1 - 1/tau and drop its trace (bulk
+// mode fully relaxed), add the forcing (1 - 1/(2 tau)) traceless(uF + Fu) + (1/3)(u.F) I and
+// j* = j + F, and rebuild f_i = w_i [rho + 3 c_i.j* + 4.5 (Pi* - rho/3 I) : (c_i c_i - I/3)].
+// The velocity is always u = (sum_i f_i c_i + F/2) / rho (in f^eq, in output, for the IBM).
+//
+// Geometry: nx x ny x nz nodes, node (i, j, k) at the physical position
+// (i + 1/2 - nx/2, j + 1/2 - ny/2, k + 1/2 - nz/2): the box is centred on the origin, where the
+// capsule sits (CONVENTIONS.md). x and y are periodic. With walls, flat walls lie halfway between
+// the outermost nodes and the (absent) next ones, at z = -nz/2 (moving with -v e_x) and z = +nz/2
+// (moving with +v e_x): link bounce-back with wall velocity (Ladd), pull form
+//   f_i(x, t+1) = f_ibar*(x, t) + 6 w_i rho0 c_i.u_w   where x - c_i lies in the wall,
+// so the shear flow is u = gamma z e_x with gamma = 2 v / nz. Without walls z is periodic too.
+//
+// Memory layout: structure of arrays (population i of every node contiguous, x fastest) and a
+// single lattice updated with the AA pattern (Bailey et al. 2009): an even step reads the 19
+// populations of a node and writes the post-collision values back to the same node in the
+// opposite slots; an odd step reads from the neighbours (slot ibar of x - c_i), collides and
+// writes to the neighbours (slot i of x + c_i). Every node reads and writes the same 19 locations
+// in both steps, so each update moves 19 + 19 doubles plus the 3 force components: 328 bytes per
+// node update (no write-allocate traffic, no second lattice). Which slot holds which population
+// therefore depends on the parity of the step; populations() hides it.
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "bendlab/core/types.hpp"
+#include "bendlab/flow/lbm/d3q19.hpp"
+
+namespace bendlab::lbm {
+
+enum class Collision {
+  Auto,         ///< BGK at tau == 1, Regularized otherwise
+  BGK,          ///< BGK + Guo at any tau (ESPResSo's scheme only at tau = 1)
+  Regularized,  ///< ESPResSo's MRT with default bulk/ghost relaxation, for any tau
+};
+
+struct LatticeConfig {
+  int nx = 0, ny = 0, nz = 0;
+  double tau = 1.0;              ///< relaxation time; viscosity nu = (tau - 1/2) / 3
+  bool walls = true;             ///< walls at z = -+nz/2; false: fully periodic box
+  double wall_velocity = 0.0;    ///< v: the top wall moves with +v e_x, the bottom one with -v e_x
+  Collision collision = Collision::Auto;
+};
+
+class Lattice {
+ public:
+  /// Validates the configuration (positive sizes, tau > 1/2, finite wall velocity) and starts at
+  /// rest with rho = 1 and a zero force field.
+  explicit Lattice(const LatticeConfig& config);
+
+  const LatticeConfig& config() const { return config_; }
+  int nx() const { return config_.nx; }
+  int ny() const { return config_.ny; }
+  int nz() const { return config_.nz; }
+  std::size_t num_nodes() const { return n_; }
+  double viscosity() const { return (config_.tau - 0.5) / 3.0; }
+  /// gamma = 2 v / nz with walls, 0 without.
+  double shear_rate() const;
+  /// The collision actually used (Auto resolved).
+  Collision collision() const { return collision_; }
+  /// Completed steps (its parity tells the AA layout of the populations).
+  std::int64_t step_count() const { return step_; }
+
+  std::size_t index(int i, int j, int k) const {
+    return static_cast<std::size_t>(i) + static_cast<std::size_t>(config_.nx) * (static_cast<std::size_t>(j) + static_cast<std::size_t>(config_.ny) * static_cast<std::size_t>(k));
+  }
+  /// (i, j, k) of a node index.
+  std::array<int, 3> coordinates(std::size_t node) const;
+  /// Physical position of node (i, j, k) (box centred on the origin).
+  Vec3 position(int i, int j, int k) const;
+
+  /// Sets every node to f^eq(rho(x), u(x)) (plus, if `stress` is given, the non-equilibrium part
+  /// -3 tau w_i rho c_i c_i : S(x) of the velocity gradient S = grad u, S(x)(a, b) = d u_b / d x_a),
+  /// evaluated at the physical node positions; resets the step count to 0.
+  void initialise(const std::function<Vec3(const Vec3&)>& velocity,
+                  const std::function<double(const Vec3&)>& density = nullptr,
+                  const std::function<Mat3(const Vec3&)>& stress = nullptr);
+  /// The exact linear shear flow u = gamma z e_x of the walls, with its non-equilibrium stress
+  /// (a steady state of the scheme); step count 0.
+  void initialise_shear_flow();
+
+  /// The force density field (force per node) applied in the next step, Guo forcing. It is not
+  /// reset by step(): velocity() uses it for the F/2 correction after the step (ESPResSo's order),
+  /// and the caller clears it before spreading new forces.
+  void clear_force();
+  void add_force(std::size_t node, const Vec3& F) {
+    force_[0][node] += F.x();
+    force_[1][node] += F.y();
+    force_[2][node] += F.z();
+  }
+  void set_uniform_force(const Vec3& F);
+  Vec3 force(std::size_t node) const { return {force_[0][node], force_[1][node], force_[2][node]}; }
+  /// Component d (0, 1, 2) of the force field, num_nodes() values.
+  double* force_data(int d) { return force_[d].data(); }
+  const double* force_data(int d) const { return force_[d].data(); }
+
+  /// One step: collide with the force field (Guo), stream, bounce back at the walls. OpenMP over
+  /// the (y, z) rows.
+  void step();
+  void run(std::int64_t steps) {
+    for (std::int64_t s = 0; s < steps; ++s) step();
+  }
+
+  /// The 19 post-stream populations of a node at the current step (layout-independent).
+  void populations(std::size_t node, double f[kQ]) const;
+  double density(std::size_t node) const;
+  /// u = (sum f c + F/2) / rho with the current force field.
+  Vec3 velocity(std::size_t node) const;
+  /// Sum of rho, and of sum f c (without F/2), over all nodes.
+  double total_mass() const;
+  Vec3 total_momentum() const;
+
+  /// The raw population store, kQ * num_nodes() doubles, slot-major, in the AA layout of
+  /// step_count() (for checkpoints).
+  const std::vector<double>& raw_populations() const { return f_; }
+  /// Replaces the raw store and the step count (sizes must match; for checkpoints).
+  void restore_raw(std::vector<double> populations, std::int64_t step);
+
+ private:
+  template <class Coll>
+  void step_with(const Coll& coll);
+
+  LatticeConfig config_;
+  Collision collision_;
+  std::size_t n_;
+  std::int64_t step_ = 0;
+  std::vector<double> f_;
+  std::array<std::vector<double>, 3> force_;
+};
+
+}  // namespace bendlab::lbm

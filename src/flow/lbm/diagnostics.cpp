@@ -1,0 +1,30 @@
+#include "bendlab/flow/lbm/diagnostics.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <limits>
+
+namespace bendlab::lbm {
+
+std::optional<BlowUp> find_blow_up(const Lattice& lattice) {
+  const auto n = static_cast<std::int64_t>(lattice.num_nodes());
+  std::int64_t first = std::numeric_limits<std::int64_t>::max();
+#pragma omp parallel for schedule(static) reduction(min : first) if (n >= (1 << 15))
+  for (std::int64_t node = 0; node < n; ++node) {
+    const double rho = lattice.density(static_cast<std::size_t>(node));
+    if (!std::isfinite(rho) || !(rho > 0)) first = std::min(first, node);
+  }
+  if (first == std::numeric_limits<std::int64_t>::max()) return std::nullopt;
+  BlowUp b;
+  b.node = static_cast<std::size_t>(first);
+  b.ijk = lattice.coordinates(b.node);
+  b.step = lattice.step_count();
+  b.density = lattice.density(b.node);
+  const Vec3 x = lattice.position(b.ijk[0], b.ijk[1], b.ijk[2]);
+  b.message = fmt::format("LBM blew up at step {}: density {} at node ({}, {}, {}) (position {:.3g}, {:.3g}, {:.3g})",
+                          b.step, b.density, b.ijk[0], b.ijk[1], b.ijk[2], x.x(), x.y(), x.z());
+  return b;
+}
+
+}  // namespace bendlab::lbm

@@ -1,0 +1,129 @@
+#include "bendlab/flow/lbm/immersed_boundary.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+namespace bendlab::lbm {
+
+double ib_kernel(IbKernel kernel, double r) {
+  const double a = std::abs(r);
+  switch (kernel) {
+    case IbKernel::Phi2:
+      return a < 1.0 ? 1.0 - a : 0.0;
+    case IbKernel::Phi3:
+      if (a <= 0.5) return (1.0 + std::sqrt(1.0 - 3.0 * a * a)) / 3.0;
+      if (a <= 1.5) return (5.0 - 3.0 * a - std::sqrt(std::max(0.0, 1.0 - 3.0 * (1.0 - a) * (1.0 - a)))) / 6.0;
+      return 0.0;
+    case IbKernel::Phi4:
+      if (a <= 1.0) return (3.0 - 2.0 * a + std::sqrt(1.0 + 4.0 * a - 4.0 * a * a)) / 8.0;
+      if (a <= 2.0) return (5.0 - 2.0 * a - std::sqrt(std::max(0.0, -7.0 + 12.0 * a - 4.0 * a * a))) / 8.0;
+      return 0.0;
+  }
+  return 0.0;
+}
+
+double ib_kernel_half_width(IbKernel kernel) {
+  switch (kernel) {
+    case IbKernel::Phi2:
+      return 1.0;
+    case IbKernel::Phi3:
+      return 1.5;
+    case IbKernel::Phi4:
+      return 2.0;
+  }
+  return 0.0;
+}
+
+namespace {
+int wrap(int i, int n) { return ((i % n) + n) % n; }
+}  // namespace
+
+IbStencil ib_stencil(const Lattice& lattice, const Vec3& X, IbKernel kernel) {
+  if (!X.allFinite()) throw Error("IB node position is not finite");
+  const int m = static_cast<int>(std::ceil(ib_kernel_half_width(kernel)));
+  const int n[3] = {lattice.nx(), lattice.ny(), lattice.nz()};
+  const bool walls = lattice.config().walls;
+  int idx[3][4];
+  double w[3][4];
+  int count = 2 * m;
+  for (int d = 0; d < 3; ++d) {
+    const double g = X[d] + 0.5 * n[d] - 0.5;  // continuous node index
+    const int base = static_cast<int>(std::floor(g)) - m + 1;
+    for (int s = 0; s < count; ++s) {
+      const int i = base + s;
+      w[d][s] = ib_kernel(kernel, g - i);
+      if (d == 2 && walls && (i < 0 || i >= n[2])) {
+        if (w[d][s] != 0.0) {
+          throw Error(fmt::format("IB node at z = {} is within the kernel's reach of a wall (walls at z = +-{})", X[2], 0.5 * n[2]));
+        }
+        idx[d][s] = 0;  // zero weight
+      } else {
+        idx[d][s] = wrap(i, n[d]);
+      }
+    }
+  }
+  IbStencil st;
+  for (int c = 0; c < count; ++c) {
+    for (int b = 0; b < count; ++b) {
+      const double wbc = w[1][b] * w[2][c];
+      for (int a = 0; a < count; ++a) {
+        st.node[st.size] = lattice.index(idx[0][a], idx[1][b], idx[2][c]);
+        st.weight[st.size] = w[0][a] * wbc;
+        ++st.size;
+      }
+    }
+  }
+  return st;
+}
+
+void spread_forces(Lattice& lattice, const Points& X, const Points& F, IbKernel kernel) {
+  if (X.rows() != F.rows()) throw Error(fmt::format("IB spreading: {} positions but {} forces", X.rows(), F.rows()));
+  for (Eigen::Index k = 0; k < X.rows(); ++k) {
+    const IbStencil st = ib_stencil(lattice, row(X, k), kernel);
+    const Vec3 Fk = row(F, k);
+    for (int s = 0; s < st.size; ++s) {
+      if (st.weight[s] != 0.0) lattice.add_force(st.node[s], st.weight[s] * Fk);
+    }
+  }
+}
+
+void interpolate_velocity(const Lattice& lattice, const Points& X, Points& U, IbKernel kernel) {
+  U.resize(X.rows(), 3);
+  const Eigen::Index n = X.rows();
+  bool failed = false;
+  std::string message;
+#pragma omp parallel for schedule(static) if (n >= 256)
+  for (Eigen::Index k = 0; k < n; ++k) {
+    try {
+      const IbStencil st = ib_stencil(lattice, row(X, k), kernel);
+      Vec3 u = Vec3::Zero();
+      for (int s = 0; s < st.size; ++s) {
+        if (st.weight[s] != 0.0) u += st.weight[s] * lattice.velocity(st.node[s]);
+      }
+      U.row(k) = u.transpose();
+    } catch (const Error& e) {
+#pragma omp critical
+      {
+        failed = true;
+        message = e.what();
+      }
+    }
+  }
+  if (failed) throw Error(message);
+}
+
+void euler_move(Points& X, const Points& U, double dt) {
+  if (X.rows() != U.rows()) throw Error(fmt::format("IB move: {} positions but {} velocities", X.rows(), U.rows()));
+  X += dt * U;
+}
+
+void ib_step(Lattice& lattice, Points& X, const Points& F, Points& U, IbKernel kernel) {
+  lattice.clear_force();
+  spread_forces(lattice, X, F, kernel);
+  lattice.step();
+  interpolate_velocity(lattice, X, U, kernel);
+  euler_move(X, U, 1.0);
+}
+
+}  // namespace bendlab::lbm

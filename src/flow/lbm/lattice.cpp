@@ -1,0 +1,479 @@
+#include "bendlab/flow/lbm/lattice.hpp"
+
+#include <fmt/format.h>
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <utility>
+
+namespace bendlab::lbm {
+
+namespace {
+
+// Everything inside the row loop must be inlined for it to vectorise.
+#if defined(__GNUC__)
+#define LBM_INLINE [[gnu::always_inline]] inline
+#else
+#define LBM_INLINE inline
+#endif
+
+// The collisions are written as straight-line code over the 19 directions (index_sequence), with
+// the velocity components folded in at compile time, so that the loop over a row vectorises
+// across nodes: no multiplication by a zero velocity component remains (the compiler may not drop
+// 0 * x or x + 0 under IEEE semantics).
+template <int C>
+LBM_INLINE double term(double v) {
+  if constexpr (C == 1) {
+    return v;
+  } else if constexpr (C == -1) {
+    return -v;
+  } else {
+    return 0.0;
+  }
+}
+// c . (a, b, c) for a D3Q19 velocity (at most two non-zero components).
+template <int X, int Y, int Z>
+LBM_INLINE double cdot(double a, double b, double c) {
+  if constexpr (X != 0 && Y != 0) {
+    return term<X>(a) + term<Y>(b);
+  } else if constexpr (X != 0 && Z != 0) {
+    return term<X>(a) + term<Z>(c);
+  } else if constexpr (Y != 0 && Z != 0) {
+    return term<Y>(b) + term<Z>(c);
+  } else if constexpr (X != 0) {
+    return term<X>(a);
+  } else if constexpr (Y != 0) {
+    return term<Y>(b);
+  } else if constexpr (Z != 0) {
+    return term<Z>(c);
+  } else {
+    return 0.0;
+  }
+}
+// c . S . c for a symmetric S.
+template <int X, int Y, int Z>
+LBM_INLINE double csc(double sxx, double syy, double szz, double sxy, double sxz, double syz) {
+  if constexpr (X != 0 && Y != 0) {
+    return sxx + syy + term<X * Y>(2.0 * sxy);
+  } else if constexpr (X != 0 && Z != 0) {
+    return sxx + szz + term<X * Z>(2.0 * sxz);
+  } else if constexpr (Y != 0 && Z != 0) {
+    return syy + szz + term<Y * Z>(2.0 * syz);
+  } else if constexpr (X != 0) {
+    return sxx;
+  } else if constexpr (Y != 0) {
+    return syy;
+  } else if constexpr (Z != 0) {
+    return szz;
+  } else {
+    return 0.0;
+  }
+}
+// sum_q c_q f_q along one axis: only the directions with a non-zero component.
+template <const std::array<int, kQ>& C, std::size_t... Q>
+LBM_INLINE double moment(const double* f, std::index_sequence<Q...>) {
+  double s = 0.0;
+  ((C[Q] == 1 ? (s += f[Q]) : (C[Q] == -1 ? (s -= f[Q]) : s)), ...);
+  return s;
+}
+template <std::size_t... Q>
+LBM_INLINE double sum(const double* f, std::index_sequence<Q...>) {
+  return (f[Q] + ...);
+}
+// sum_q c_qa c_qb f_q for a != b.
+template <const std::array<int, kQ>& A, const std::array<int, kQ>& B, std::size_t... Q>
+LBM_INLINE double cross_moment(const double* f, std::index_sequence<Q...>) {
+  double s = 0.0;
+  ((A[Q] * B[Q] == 1 ? (s += f[Q]) : (A[Q] * B[Q] == -1 ? (s -= f[Q]) : s)), ...);
+  return s;
+}
+// sum_q c_qa^2 f_q.
+template <const std::array<int, kQ>& A, std::size_t... Q>
+LBM_INLINE double square_moment(const double* f, std::index_sequence<Q...>) {
+  double s = 0.0;
+  ((A[Q] != 0 ? (s += f[Q]) : s), ...);
+  return s;
+}
+using Directions = std::make_index_sequence<kQ>;
+
+// BGK + Guo (technical note section 1), omega = 1/tau, a = 1 - 1/(2 tau).
+struct Bgk {
+  double omega, a;
+  template <std::size_t Q>
+  LBM_INLINE void relax(double* f, double rho, double ux, double uy, double uz, double uu, double uF,
+                    double Fx, double Fy, double Fz) const {
+    constexpr int X = kCx[Q], Y = kCy[Q], Z = kCz[Q];
+    const double cu = cdot<X, Y, Z>(ux, uy, uz);
+    const double cF = cdot<X, Y, Z>(Fx, Fy, Fz);
+    const double feq = kW[Q] * rho * (1.0 + 3.0 * cu + 4.5 * cu * cu - 1.5 * uu);
+    const double guo = kW[Q] * (3.0 * (cF - uF) + 9.0 * cu * cF);
+    f[Q] = f[Q] - omega * (f[Q] - feq) + a * guo;
+  }
+  template <std::size_t... Q>
+  LBM_INLINE void apply(double* f, double Fx, double Fy, double Fz, std::index_sequence<Q...> d) const {
+    const double rho = sum(f, d);
+    const double jx = moment<kCx>(f, d), jy = moment<kCy>(f, d), jz = moment<kCz>(f, d);
+    const double ir = 1.0 / rho;
+    const double ux = (jx + 0.5 * Fx) * ir, uy = (jy + 0.5 * Fy) * ir, uz = (jz + 0.5 * Fz) * ir;
+    const double uu = ux * ux + uy * uy + uz * uz, uF = ux * Fx + uy * Fy + uz * Fz;
+    (relax<Q>(f, rho, ux, uy, uz, uu, uF, Fx, Fy, Fz), ...);
+  }
+  LBM_INLINE void operator()(double* f, double Fx, double Fy, double Fz) const { apply(f, Fx, Fy, Fz, Directions{}); }
+};
+
+// ESPResSo's MRT with default bulk and ghost relaxation as a regularised scheme (section 1):
+// gs = 1 - 1/tau relaxes the traceless non-equilibrium stress, the trace is dropped, as = 1 - 1/(2 tau).
+struct Regularized {
+  double gs, as;
+  template <std::size_t Q>
+  LBM_INLINE static void rebuild(double* f, double rho, double jsx, double jsy, double jsz, double sxx, double syy,
+                             double szz, double sxy, double sxz, double syz, double trs) {
+    constexpr int X = kCx[Q], Y = kCy[Q], Z = kCz[Q];
+    const double ss = csc<X, Y, Z>(sxx, syy, szz, sxy, sxz, syz) - trs;
+    f[Q] = kW[Q] * (rho + 3.0 * cdot<X, Y, Z>(jsx, jsy, jsz) + 4.5 * ss);
+  }
+  template <std::size_t... Q>
+  LBM_INLINE void apply(double* f, double Fx, double Fy, double Fz, std::index_sequence<Q...> d) const {
+    const double rho = sum(f, d);
+    const double jx = moment<kCx>(f, d), jy = moment<kCy>(f, d), jz = moment<kCz>(f, d);
+    const double pxx = square_moment<kCx>(f, d), pyy = square_moment<kCy>(f, d), pzz = square_moment<kCz>(f, d);
+    const double pxy = cross_moment<kCx, kCy>(f, d), pxz = cross_moment<kCx, kCz>(f, d), pyz = cross_moment<kCy, kCz>(f, d);
+    const double ir = 1.0 / rho;
+    const double ux = (jx + 0.5 * Fx) * ir, uy = (jy + 0.5 * Fy) * ir, uz = (jz + 0.5 * Fz) * ir;
+    const double r3 = rho / 3.0;
+    const double nxx = pxx - r3 - rho * ux * ux, nyy = pyy - r3 - rho * uy * uy, nzz = pzz - r3 - rho * uz * uz;
+    const double nxy = pxy - rho * ux * uy, nxz = pxz - rho * ux * uz, nyz = pyz - rho * uy * uz;
+    const double tr = (nxx + nyy + nzz) / 3.0;
+    const double uF = ux * Fx + uy * Fy + uz * Fz;
+    const double iso = uF / 3.0 - as * (2.0 / 3.0) * uF;
+    // S = Pi* - rho/3 I.
+    const double sxx = rho * ux * ux + gs * (nxx - tr) + 2.0 * as * ux * Fx + iso;
+    const double syy = rho * uy * uy + gs * (nyy - tr) + 2.0 * as * uy * Fy + iso;
+    const double szz = rho * uz * uz + gs * (nzz - tr) + 2.0 * as * uz * Fz + iso;
+    const double sxy = rho * ux * uy + gs * nxy + as * (ux * Fy + uy * Fx);
+    const double sxz = rho * ux * uz + gs * nxz + as * (ux * Fz + uz * Fx);
+    const double syz = rho * uy * uz + gs * nyz + as * (uy * Fz + uz * Fy);
+    const double trs = (sxx + syy + szz) / 3.0;
+    (rebuild<Q>(f, rho, jx + Fx, jy + Fy, jz + Fz, sxx, syy, szz, sxy, sxz, syz, trs), ...);
+  }
+  LBM_INLINE void operator()(double* f, double Fx, double Fy, double Fz) const { apply(f, Fx, Fy, Fz, Directions{}); }
+};
+
+constexpr std::size_t kParallelNodes = std::size_t{1} << 15;
+
+struct StepArgs {
+  double* f;
+  std::size_t n;
+  int nx, ny, nz;
+  bool walls, odd;
+  double v;
+  const double* F[3];
+};
+
+// Where each of the 19 populations of a run of nodes x0..x1-1 in one row is read from and written
+// to: slot base + offset + x, plus a constant (the wall term of the bounce-back).
+struct RowPlan {
+  const double* rbase[kQ];
+  double* wbase[kQ];
+  std::ptrdiff_t roff[kQ], woff[kQ];
+  double radd[kQ], wadd[kQ];
+};
+
+LBM_INLINE int wrap(int i, int n) { return ((i % n) + n) % n; }
+
+template <bool kAdd, class Coll, std::size_t... Q>
+LBM_INLINE void row_kernel_impl(const RowPlan& p, const double* __restrict Fx, const double* __restrict Fy,
+                            const double* __restrict Fz, int x0, int x1, const Coll& coll, std::index_sequence<Q...>) {
+  const double* r[kQ] = {(p.rbase[Q] + (p.roff[Q] + x0))...};
+  double* w[kQ] = {(p.wbase[Q] + (p.woff[Q] + x0))...};
+  const double* fx = Fx + x0;
+  const double* fy = Fy + x0;
+  const double* fz = Fz + x0;
+  const int n = x1 - x0;
+  // Each node reads and writes its own 19 locations (AA pattern): the iterations are independent.
+#pragma GCC ivdep
+  for (int x = 0; x < n; ++x) {
+    double f[kQ];
+    if constexpr (kAdd) {
+      ((f[Q] = r[Q][x] + p.radd[Q]), ...);
+    } else {
+      ((f[Q] = r[Q][x]), ...);
+    }
+    coll(f, fx[x], fy[x], fz[x]);
+    if constexpr (kAdd) {
+      ((w[Q][x] = f[Q] + p.wadd[Q]), ...);
+    } else {
+      ((w[Q][x] = f[Q]), ...);
+    }
+  }
+}
+
+template <bool kAdd, class Coll>
+LBM_INLINE void row_kernel(const RowPlan& p, const double* Fx, const double* Fy, const double* Fz, int x0, int x1, const Coll& coll) {
+  row_kernel_impl<kAdd>(p, Fx, Fy, Fz, x0, x1, coll, Directions{});
+}
+
+// The odd (streaming) step's plan for row (j, k): xe < 0 gives the offsets of the interior nodes
+// (x - c_x stays in the row), xe >= 0 those of the single node x = xe with periodic wrap in x.
+// Returns whether any link of the row meets a wall.
+bool odd_plan(const StepArgs& a, int j, int k, int xe, RowPlan& p) {
+  const std::size_t n = a.n;
+  const std::ptrdiff_t row = static_cast<std::ptrdiff_t>(a.nx) * (j + static_cast<std::ptrdiff_t>(a.ny) * k);
+  bool wall = false;
+  for (int q = 0; q < kQ; ++q) {
+    const int qb = opposite(q);
+    // Read population q from x - c_q (slot qbar), or bounce it back from the wall.
+    int ks = k - kCz[q];
+    if (a.walls && (ks < 0 || ks >= a.nz)) {
+      const double uw = ks < 0 ? -a.v : a.v;
+      p.rbase[q] = a.f + q * n;
+      p.roff[q] = row;
+      p.radd[q] = 6.0 * kW[q] * kCx[q] * uw;
+      wall = true;
+    } else {
+      ks = wrap(ks, a.nz);
+      const int js = wrap(j - kCy[q], a.ny);
+      const std::ptrdiff_t srow = static_cast<std::ptrdiff_t>(a.nx) * (js + static_cast<std::ptrdiff_t>(a.ny) * ks);
+      p.rbase[q] = a.f + qb * n;
+      p.roff[q] = xe < 0 ? srow - kCx[q] : srow + wrap(xe - kCx[q], a.nx) - xe;
+      p.radd[q] = 0.0;
+    }
+    // Write post-collision population q to x + c_q (slot q), or reflect it at the wall into
+    // slot qbar of this node, where the next (even) step reads population qbar.
+    int kd = k + kCz[q];
+    if (a.walls && (kd < 0 || kd >= a.nz)) {
+      const double uw = kd < 0 ? -a.v : a.v;
+      p.wbase[q] = a.f + qb * n;
+      p.woff[q] = row;
+      p.wadd[q] = -6.0 * kW[q] * kCx[q] * uw;
+      wall = true;
+    } else {
+      kd = wrap(kd, a.nz);
+      const int jd = wrap(j + kCy[q], a.ny);
+      const std::ptrdiff_t drow = static_cast<std::ptrdiff_t>(a.nx) * (jd + static_cast<std::ptrdiff_t>(a.ny) * kd);
+      p.wbase[q] = a.f + q * n;
+      p.woff[q] = xe < 0 ? drow + kCx[q] : drow + wrap(xe + kCx[q], a.nx) - xe;
+      p.wadd[q] = 0.0;
+    }
+  }
+  return wall;
+}
+
+template <class Coll>
+LBM_INLINE void process_rows_impl(const StepArgs& a, int row0, int row1, const Coll& coll) {
+  RowPlan p;
+  for (int r = row0; r < row1; ++r) {
+    const int j = r % a.ny, k = r / a.ny;
+    const std::ptrdiff_t row = static_cast<std::ptrdiff_t>(a.nx) * r;
+    const double* Fx = a.F[0] + row;
+    const double* Fy = a.F[1] + row;
+    const double* Fz = a.F[2] + row;
+    if (!a.odd) {
+      for (int q = 0; q < kQ; ++q) {
+        p.rbase[q] = a.f + q * a.n;
+        p.wbase[q] = a.f + opposite(q) * a.n;
+        p.roff[q] = p.woff[q] = row;
+      }
+      row_kernel<false>(p, Fx, Fy, Fz, 0, a.nx, coll);
+      continue;
+    }
+    if (a.nx > 2) {
+      if (odd_plan(a, j, k, -1, p)) {
+        row_kernel<true>(p, Fx, Fy, Fz, 1, a.nx - 1, coll);
+      } else {
+        row_kernel<false>(p, Fx, Fy, Fz, 1, a.nx - 1, coll);
+      }
+    }
+    // The row ends, where x -+ c_x wraps: x = 0 and (if it is another node) x = nx - 1.
+    for (int e = 0; e < (a.nx > 1 ? 2 : 1); ++e) {
+      const int xe = e == 0 ? 0 : a.nx - 1;
+      if (odd_plan(a, j, k, xe, p)) {
+        row_kernel<true>(p, Fx, Fy, Fz, xe, xe + 1, coll);
+      } else {
+        row_kernel<false>(p, Fx, Fy, Fz, xe, xe + 1, coll);
+      }
+    }
+  }
+}
+
+// The row loops, compiled for AVX-512, AVX2 and the baseline and chosen when the program starts.
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+#define BENDLAB_LBM_CLONES __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
+#else
+#define BENDLAB_LBM_CLONES
+#endif
+
+BENDLAB_LBM_CLONES void process_rows_bgk(const StepArgs& a, int row0, int row1, const Bgk& c) {
+  process_rows_impl(a, row0, row1, c);
+}
+BENDLAB_LBM_CLONES void process_rows_reg(const StepArgs& a, int row0, int row1, const Regularized& c) {
+  process_rows_impl(a, row0, row1, c);
+}
+void process_rows(const StepArgs& a, int row0, int row1, const Bgk& c) { process_rows_bgk(a, row0, row1, c); }
+void process_rows(const StepArgs& a, int row0, int row1, const Regularized& c) { process_rows_reg(a, row0, row1, c); }
+
+}  // namespace
+
+Lattice::Lattice(const LatticeConfig& config) : config_(config) {
+  if (config.nx < 1 || config.ny < 1 || config.nz < 1) {
+    throw Error(fmt::format("LBM lattice size {} x {} x {} must be positive", config.nx, config.ny, config.nz));
+  }
+  if (!(config.tau > 0.5) || !std::isfinite(config.tau)) {
+    throw Error(fmt::format("LBM relaxation time tau = {} must be finite and exceed 1/2", config.tau));
+  }
+  if (!std::isfinite(config.wall_velocity)) throw Error("LBM wall velocity is not finite");
+  if (config.walls && config.nz < 2) throw Error("LBM lattice between walls needs at least 2 layers in z");
+  collision_ = config.collision;
+  if (collision_ == Collision::Auto) collision_ = config.tau == 1.0 ? Collision::BGK : Collision::Regularized;
+  n_ = static_cast<std::size_t>(config.nx) * config.ny * config.nz;
+  f_.assign(kQ * n_, 0.0);
+  for (auto& F : force_) F.assign(n_, 0.0);
+  initialise([](const Vec3&) { return Vec3::Zero(); });
+}
+
+double Lattice::shear_rate() const { return config_.walls ? 2.0 * config_.wall_velocity / config_.nz : 0.0; }
+
+std::array<int, 3> Lattice::coordinates(std::size_t node) const {
+  const int i = static_cast<int>(node % config_.nx);
+  const std::size_t r = node / config_.nx;
+  return {i, static_cast<int>(r % config_.ny), static_cast<int>(r / config_.ny)};
+}
+
+Vec3 Lattice::position(int i, int j, int k) const {
+  return {i + 0.5 - 0.5 * config_.nx, j + 0.5 - 0.5 * config_.ny, k + 0.5 - 0.5 * config_.nz};
+}
+
+void Lattice::initialise(const std::function<Vec3(const Vec3&)>& velocity,
+                         const std::function<double(const Vec3&)>& density,
+                         const std::function<Mat3(const Vec3&)>& stress) {
+  const double tau = config_.tau;
+  for (int k = 0; k < config_.nz; ++k) {
+    for (int j = 0; j < config_.ny; ++j) {
+      for (int i = 0; i < config_.nx; ++i) {
+        const Vec3 x = position(i, j, k);
+        const Vec3 u = velocity(x);
+        const double rho = density ? density(x) : 1.0;
+        Mat3 S = Mat3::Zero();
+        if (stress) S = stress(x);
+        const std::size_t node = index(i, j, k);
+        for (int q = 0; q < kQ; ++q) {
+          double v = equilibrium(q, rho, u.x(), u.y(), u.z());
+          if (stress) {
+            const Vec3 c(kCx[q], kCy[q], kCz[q]);
+            v -= 3.0 * tau * kW[q] * rho * (c.dot(S * c) - S.trace() / 3.0);
+          }
+          f_[q * n_ + node] = v;
+        }
+      }
+    }
+  }
+  step_ = 0;
+}
+
+void Lattice::initialise_shear_flow() {
+  const double g = shear_rate();
+  Mat3 S = Mat3::Zero();
+  S(2, 0) = g;  // d u_x / d z
+  initialise([g](const Vec3& x) { return Vec3(g * x.z(), 0.0, 0.0); }, nullptr, [S](const Vec3&) { return S; });
+}
+
+void Lattice::clear_force() {
+  for (auto& F : force_) std::fill(F.begin(), F.end(), 0.0);
+}
+
+void Lattice::set_uniform_force(const Vec3& F) {
+  for (int d = 0; d < 3; ++d) std::fill(force_[d].begin(), force_[d].end(), F[d]);
+}
+
+template <class Coll>
+void Lattice::step_with(const Coll& coll) {
+  StepArgs a{f_.data(), n_, config_.nx, config_.ny, config_.nz, config_.walls, step_ % 2 == 1,
+             config_.wall_velocity, {force_[0].data(), force_[1].data(), force_[2].data()}};
+  const int rows = config_.ny * config_.nz;
+  // Small lattices (tests) step on one thread: a parallel region costs more than their update.
+#pragma omp parallel if (n_ >= kParallelNodes)
+  {
+    const int t = omp_get_thread_num(), nt = omp_get_num_threads();
+    const int r0 = static_cast<int>(static_cast<std::int64_t>(rows) * t / nt);
+    const int r1 = static_cast<int>(static_cast<std::int64_t>(rows) * (t + 1) / nt);
+    process_rows(a, r0, r1, coll);
+  }
+  ++step_;
+}
+
+void Lattice::step() {
+  const double tau = config_.tau;
+  if (collision_ == Collision::BGK) {
+    step_with(Bgk{1.0 / tau, 1.0 - 0.5 / tau});
+  } else {
+    step_with(Regularized{1.0 - 1.0 / tau, 1.0 - 0.5 / tau});
+  }
+}
+
+void Lattice::populations(std::size_t node, double f[kQ]) const {
+  if (step_ % 2 == 0) {
+    for (int q = 0; q < kQ; ++q) f[q] = f_[q * n_ + node];
+    return;
+  }
+  // After an even step slot qbar of node x - c_q holds the post-collision f_q of that node.
+  const auto [i, j, k] = coordinates(node);
+  for (int q = 0; q < kQ; ++q) {
+    const int ks = k - kCz[q];
+    if (config_.walls && (ks < 0 || ks >= config_.nz)) {
+      const double uw = ks < 0 ? -config_.wall_velocity : config_.wall_velocity;
+      f[q] = f_[q * n_ + node] + 6.0 * kW[q] * kCx[q] * uw;
+    } else {
+      const std::size_t src = index(wrap(i - kCx[q], config_.nx), wrap(j - kCy[q], config_.ny), wrap(ks, config_.nz));
+      f[q] = f_[opposite(q) * n_ + src];
+    }
+  }
+}
+
+double Lattice::density(std::size_t node) const {
+  double f[kQ];
+  populations(node, f);
+  double rho = 0;
+  for (int q = 0; q < kQ; ++q) rho += f[q];
+  return rho;
+}
+
+Vec3 Lattice::velocity(std::size_t node) const {
+  double f[kQ];
+  populations(node, f);
+  double rho = 0;
+  Vec3 j = Vec3::Zero();
+  for (int q = 0; q < kQ; ++q) {
+    rho += f[q];
+    j += f[q] * Vec3(kCx[q], kCy[q], kCz[q]);
+  }
+  return (j + 0.5 * force(node)) / rho;
+}
+
+double Lattice::total_mass() const {
+  double m = 0;
+  for (std::size_t node = 0; node < n_; ++node) m += density(node);
+  return m;
+}
+
+Vec3 Lattice::total_momentum() const {
+  Vec3 p = Vec3::Zero();
+  double f[kQ];
+  for (std::size_t node = 0; node < n_; ++node) {
+    populations(node, f);
+    for (int q = 0; q < kQ; ++q) p += f[q] * Vec3(kCx[q], kCy[q], kCz[q]);
+  }
+  return p;
+}
+
+void Lattice::restore_raw(std::vector<double> populations, std::int64_t step) {
+  if (populations.size() != f_.size()) {
+    throw Error(fmt::format("LBM state has {} populations, the lattice needs {}", populations.size(), f_.size()));
+  }
+  if (step < 0) throw Error(fmt::format("LBM step count {} is negative", step));
+  f_ = std::move(populations);
+  step_ = step;
+}
+
+}  // namespace bendlab::lbm

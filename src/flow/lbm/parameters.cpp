@@ -1,0 +1,69 @@
+#include "bendlab/flow/lbm/parameters.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+namespace bendlab::lbm {
+
+LatticeConfig CapsuleRunParameters::lattice_config() const {
+  LatticeConfig c;
+  c.nx = nx;
+  c.ny = ny;
+  c.nz = nz;
+  c.tau = tau;
+  c.walls = true;
+  c.wall_velocity = wall_velocity;
+  return c;
+}
+
+CapsuleRunParameters capsule_run_parameters(const CapsuleRunInput& in) {
+  if (!(in.radius > 0) || !std::isfinite(in.radius)) throw Error(fmt::format("capsule radius R = {} must be positive", in.radius));
+  if (!(in.tau > 0.5) || !std::isfinite(in.tau)) {
+    throw Error(fmt::format("LBM relaxation time tau = {} must exceed 1/2 (viscosity (tau - 1/2)/3 > 0)", in.tau));
+  }
+  if (!(in.reynolds > 0) || !std::isfinite(in.reynolds)) throw Error(fmt::format("Reynolds number {} must be positive", in.reynolds));
+  if (!(in.G > 0) || !std::isfinite(in.G)) throw Error(fmt::format("capillary number G = {} must be positive", in.G));
+  if (!(in.kB_hat >= 0) || !std::isfinite(in.kB_hat)) throw Error(fmt::format("bending modulus kB_hat = {} must be non-negative", in.kB_hat));
+  if (!(in.gamma_t_end > 0)) throw Error(fmt::format("end time gamma t = {} must be positive", in.gamma_t_end));
+  const double R = in.radius, h = ib_kernel_half_width(in.kernel);
+  CapsuleRunParameters p;
+  auto nodes = [&](double multiple, const char* axis) {
+    if (!(multiple > 0) || !std::isfinite(multiple)) throw Error(fmt::format("box {} = {} R must be positive", axis, multiple));
+    return static_cast<int>(std::lround(multiple * R));
+  };
+  p.nx = nodes(in.box_x, "x");
+  p.ny = nodes(in.box_y, "y");
+  p.nz = nodes(in.box_z, "z");
+  // The capsule's diameter plus the kernel support on both sides must fit in a periodic period.
+  for (auto [n, axis] : {std::pair{p.nx, "x"}, std::pair{p.ny, "y"}}) {
+    if (n < 2.0 * (R + h)) {
+      throw Error(fmt::format("box {} of {} nodes does not contain the capsule (diameter {} plus kernel support {})", axis, n, 2 * R, 2 * h));
+    }
+  }
+  if (0.5 * p.nz <= R + h) {
+    throw Error(fmt::format("capsule (R = {} plus kernel half-width {}) touches the walls at z = +-{}", R, h, 0.5 * p.nz));
+  }
+  p.tau = in.tau;
+  p.nu = (in.tau - 0.5) / 3.0;
+  p.mu = p.nu;  // rho0 = 1
+  p.reynolds = in.reynolds;
+  p.wall_velocity = in.reynolds * p.nu / R;
+  p.shear_rate = 2.0 * p.wall_velocity / p.nz;
+  p.mach = p.wall_velocity * std::sqrt(3.0);
+  if (p.mach > 0.1) {
+    throw Error(fmt::format("wall Mach number {:.3g} exceeds 0.1 (lower Re = {} or raise tau)", p.mach, in.reynolds));
+  }
+  p.particle_reynolds = p.shear_rate * R * R / p.nu;
+  p.kS = p.mu * p.shear_rate * R / in.G;
+  p.kB = in.kB_hat * R * R * p.kS;
+  p.kV = in.kV_over_kS * p.kS;
+  p.steps = static_cast<std::int64_t>(std::ceil(in.gamma_t_end / p.shear_rate));
+  if (in.reynolds > 0.3) {
+    p.warnings.push_back(fmt::format("Reynolds number Re = R v / nu = {} is above the paper's bound 0.3", in.reynolds));
+  }
+  if (p.mach > 0.01) p.warnings.push_back(fmt::format("wall Mach number {:.3g} is above the paper's 0.01", p.mach));
+  return p;
+}
+
+}  // namespace bendlab::lbm

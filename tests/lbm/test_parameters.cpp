@@ -1,0 +1,74 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "bendlab/flow/lbm/parameters.hpp"
+
+using namespace bendlab;
+using namespace bendlab::lbm;
+
+namespace {
+// The message of the Error thrown for `in`, or "" if none.
+std::string error_of(const CapsuleRunInput& in) {
+  try {
+    capsule_run_parameters(in);
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+}  // namespace
+
+TEST(CapsuleRunParameters, PaperSetup) {
+  const CapsuleRunInput in;  // R = 13.5, tau = 1, 9.5 R x 9.5 R x 19 R, Re = 0.26
+  const CapsuleRunParameters p = capsule_run_parameters(in);
+  EXPECT_EQ(p.nx, 128);
+  EXPECT_EQ(p.ny, 128);
+  EXPECT_EQ(p.nz, std::lround(19 * 13.5));
+  EXPECT_DOUBLE_EQ(p.nu, 1.0 / 6.0);
+  EXPECT_DOUBLE_EQ(p.wall_velocity * in.radius / p.nu, in.reynolds);
+  EXPECT_DOUBLE_EQ(p.shear_rate, 2 * p.wall_velocity / p.nz);
+  EXPECT_DOUBLE_EQ(p.mu * p.shear_rate * in.radius / p.kS, in.G);
+  EXPECT_DOUBLE_EQ(p.kB / (in.radius * in.radius * p.kS), in.kB_hat);
+  EXPECT_DOUBLE_EQ(p.kV, 100 * p.kS);
+  EXPECT_LT(p.mach, 0.01);
+  EXPECT_GE(p.steps * p.shear_rate, 10.0);
+  EXPECT_LT((p.steps - 1) * p.shear_rate, 10.0);
+  EXPECT_TRUE(p.warnings.empty());
+  const LatticeConfig c = p.lattice_config();
+  EXPECT_EQ(c.nz, p.nz);
+  EXPECT_TRUE(c.walls);
+  EXPECT_DOUBLE_EQ(c.wall_velocity, p.wall_velocity);
+}
+
+TEST(CapsuleRunParameters, RejectsBadSetups) {
+  CapsuleRunInput in;
+  in.tau = 0.5;
+  EXPECT_NE(error_of(in).find("tau"), std::string::npos);
+  in = {};
+  in.box_x = 2.0;  // 27 nodes < 2 (R + 1)
+  EXPECT_NE(error_of(in).find("does not contain the capsule"), std::string::npos);
+  in = {};
+  in.box_y = 1.5;
+  EXPECT_NE(error_of(in).find("box y"), std::string::npos);
+  in = {};
+  in.box_z = 2.1;  // nz = 28: the walls at +-14 touch R + 1 = 14.5
+  EXPECT_NE(error_of(in).find("touches the walls"), std::string::npos);
+  in = {};
+  in.reynolds = 5.0;  // v = 5/6/13.5, Ma = 0.107
+  EXPECT_NE(error_of(in).find("Mach"), std::string::npos);
+  in = {};
+  in.G = 0;
+  EXPECT_NE(error_of(in).find("G ="), std::string::npos);
+  in = {};
+  EXPECT_EQ(error_of(in), "");
+}
+
+TEST(CapsuleRunParameters, WarnsAboveThePapersReynoldsNumber) {
+  CapsuleRunInput in;
+  in.reynolds = 0.5;
+  const CapsuleRunParameters p = capsule_run_parameters(in);
+  ASSERT_FALSE(p.warnings.empty());
+  EXPECT_NE(p.warnings.front().find("Reynolds"), std::string::npos);
+}
