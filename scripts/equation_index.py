@@ -51,6 +51,8 @@ def equations_in(text):
     """The equation labels cited in text."""
     found = set()
     for m in re.finditer(r"\beqs?\.?\s*((?:\(?[AB]?\.?\d+\)?\s*(?:-|–|,|and|to)?\s*)+)", text, re.I):
+        if "al." in text[max(0, m.start() - 12):m.start()]:
+            continue  # another paper's equation ("Dupin et al. eq. 9")
         span = m.group(1)
         labels = re.findall(r"([AB]\.\d+|\d+)", span)
         # A range "(18)-(21)" or "7-9" cites every equation between.
