@@ -40,3 +40,32 @@ std::unique_ptr<AnalyticSurface> surface_from_options(const std::string& shape, 
 }
 
 }  // namespace bendlab::cli
+
+#include <spawn.h>
+#include <cerrno>
+#include <sys/wait.h>
+
+extern char** environ;
+
+namespace bendlab::cli {
+
+std::filesystem::path executable_folder() {
+  std::error_code ec;
+  const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  return ec ? std::filesystem::path() : exe.parent_path();
+}
+
+int run_program(const std::vector<std::string>& argv) {
+  if (argv.empty()) return -1;
+  std::vector<char*> args;
+  for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+  args.push_back(nullptr);
+  pid_t pid = 0;
+  if (posix_spawn(&pid, args[0], nullptr, nullptr, args.data(), environ) != 0) return -1;
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0)
+    if (errno != EINTR) return -1;
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+}  // namespace bendlab::cli

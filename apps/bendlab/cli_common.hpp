@@ -24,3 +24,13 @@ std::unique_ptr<AnalyticSurface> surface_from_options(const std::string& shape, 
                                                       const std::vector<double>& axes);
 
 }  // namespace bendlab::cli
+
+namespace bendlab::cli {
+
+/// The folder of the running executable (from /proc/self/exe), empty if unknown.
+std::filesystem::path executable_folder();
+/// Runs `argv[0]` with the arguments argv (no shell) and waits; returns its exit status, or -1 if
+/// it could not be started or did not exit normally.
+int run_program(const std::vector<std::string>& argv);
+
+}  // namespace bendlab::cli
