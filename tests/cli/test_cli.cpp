@@ -197,9 +197,9 @@ TEST_F(Cli, ShearStoppedAndResumedEqualsUninterrupted) {
   const fs::path full = dir / "full", parts = dir / "parts";
   CliRun r = run("shear" + common + full.string());
   ASSERT_EQ(r.status, 0) << r.err;
-  r = run("shear --stop-after-steps 10" + common + parts.string());
+  r = run("shear --stop-after-steps 4" + common + parts.string());
   ASSERT_EQ(r.status, 0) << r.err;
-  EXPECT_NE(r.err.find("stopped after 10 steps"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("stopped after 4 steps"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(parts / "summary.json"));
   r = run("shear --resume" + common + parts.string());
   ASSERT_EQ(r.status, 0) << r.err;

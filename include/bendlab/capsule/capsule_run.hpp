@@ -12,7 +12,7 @@
 // restores the solver and continues; its summary.json then equals the uninterrupted run's exactly,
 // except "wall_seconds" (the wall time of all parts; a clock, not a result). If t_end changed so
 // that the steady window moved, the window's sums are recomputed from timeseries.csv (to the
-// precision of the file) and a note says so.
+// precision of the file: dt has 6 digits, so about 1e-6 relative) and a note says so.
 //
 // Every write is checked: a failed write throws bendlab::Error naming the file, and the last
 // complete checkpoint stays in place. Nothing here prints: progress and notes go to callbacks.
