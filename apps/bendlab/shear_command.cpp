@@ -65,7 +65,7 @@ std::optional<fs::path> plot_script(const std::string& given) {
       candidates.push_back(exe / rel);
   candidates.push_back(fs::path(BENDLAB_SOURCE_DIR) / "scripts" / "plot_shear.py");
   for (const fs::path& c : candidates)
-    if (fs::exists(c)) return c;
+    if (fs::exists(c)) return fs::weakly_canonical(c);
   return std::nullopt;
 }
 

@@ -35,7 +35,8 @@ struct AcceptedStep {
 /// The solver-specific part of a checkpoint: JSON fields, plus side files the solver wrote into
 /// the run folder (names relative to it). The run deletes the side files of an older checkpoint
 /// once a newer checkpoint.json has been committed, so a solver must give its side files names
-/// unique to `tag` (e.g. "lbm_fluid_<tag>.bin") and write them whole (AtomicFile).
+/// unique to `tag` (e.g. "lbm_fluid_<tag>.bin") and write them whole (AtomicFile). restore_state
+/// gets `fields` only, so a solver also names its side files there.
 struct SolverState {
   nlohmann::json fields = nlohmann::json::object();
   std::vector<std::string> side_files;
