@@ -39,13 +39,14 @@ class CapsuleRun : public ::testing::Test {
   void TearDown() override { fs::remove_all(dir); }
 
   // 320 triangles, G = 0.1, no bending: the CLI's smallest shear run.
-  static std::shared_ptr<const MembraneModel> membrane() {
-    static const TriMesh mesh = sphere_mesh(MeshFamily::MT1, 2);
+  static std::shared_ptr<const MembraneModel> membrane(int level = 2) {
     MembraneParameters p;
     p.kS = ShearUnits::from(0.1, 0.0, std::nullopt).kS();
-    return std::make_shared<const MembraneModel>(mesh, p);
+    return std::make_shared<const MembraneModel>(sphere_mesh(MeshFamily::MT1, level), p);
   }
-  static std::unique_ptr<BimCapsuleSolver> solver() { return std::make_unique<BimCapsuleSolver>(membrane()); }
+  static std::unique_ptr<BimCapsuleSolver> solver(int level = 2) {
+    return std::make_unique<BimCapsuleSolver>(membrane(level));
+  }
   CapsuleRunOptions options(const fs::path& folder, double t_end = 0.3) const {
     CapsuleRunOptions o;
     o.folder = folder;
@@ -278,10 +279,10 @@ TEST_F(CapsuleRun, FailedSnapshotWriteEndsTheRunAndKeepsTheCheckpoint) {
 }
 
 TEST_F(CapsuleRun, ManyRunsInOneProcess) {
-  // Creating and destroying runs, solvers and membranes over and over is safe (run this under the
-  // sanitizers: cmake --preset debug).
+  // Creating and destroying runs, solvers, membranes and meshes over and over is safe (run this
+  // under the sanitizers: cmake --preset debug). 80 triangles and two steps each keep it fast there.
   for (int k = 0; k < 50; ++k) {
-    auto s = solver();
+    auto s = solver(1);
     CapsuleRunOptions o = options(dir / ("run" + std::to_string(k % 3)), 0.002);
     o.snapshot_every = 0.001;
     int progress = 0;
