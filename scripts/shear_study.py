@@ -135,7 +135,7 @@ class Run:
 
     def arguments(self, out):
         return ["shear", "--method", self.method, "--mesh", self.mesh, "--G", fmt_g(self.G),
-                "--kappa-b", fmt_g(self.kappa_b), "--t-end", fmt_g(self.t_end), "--out", str(out),
+                "--kappa-b-hat", fmt_g(self.kappa_b), "--t-end", fmt_g(self.t_end), "--out", str(out),
                 "--no-plot"]
 
 
@@ -166,11 +166,21 @@ def summary_matches(summary, run):
         return False
 
 
+# The steady window of each t_end, as `bendlab shear` reports it in summary.json (the library
+# defines the window and its statistics; this script only reads them).
+_steady_windows = {}
+
+
 def read_summary(path):
     try:
-        return json.loads(path.read_text())
+        summary = json.loads(path.read_text())
     except (OSError, ValueError):
         return None
+    try:
+        _steady_windows[float(summary["t_end"])] = [float(x) for x in summary["steady_window"]]
+    except (KeyError, TypeError, ValueError):
+        pass
+    return summary
 
 
 def read_series(run_dir):
@@ -188,7 +198,7 @@ def checkpoint_matches(run_dir, run):
     except (OSError, ValueError, KeyError, TypeError):
         return False
     return (args.get("method") == run.method and args.get("mesh") == run.mesh
-            and close(args.get("G"), run.G) and close(args.get("kappa_b"), run.kappa_b))
+            and close(args.get("G"), run.G) and close(args.get("kappa_b_hat"), run.kappa_b))
 
 
 def execute(run, work, bendlab, counter, total):
@@ -332,7 +342,9 @@ def num(x, digits=4):
 
 
 def steady_label(t_end):
-    return "[5, 10]" if t_end >= 10 else f"[{fmt_g(t_end / 2)}, {fmt_g(t_end)}]"
+    """The steady window of the runs ending at t_end, from their summary.json."""
+    w = _steady_windows.get(float(t_end))
+    return f"[{fmt_g(w[0])}, {fmt_g(w[1])}]" if w else "(the window of summary.json)"
 
 
 def fit_slope(G, D):
@@ -713,7 +725,7 @@ def main():
              f"- parts shown: {', '.join(shown)}" + (f"; failed runs: {len(failed)}" if failed else ""),
              f"- source commit: {commit}" if commit else None,
              "",
-             "Every run is `bendlab shear --method M --mesh mt1:N --G G --kappa-b KB --t-end T --no-plot` "
+             "Every run is `bendlab shear --method M --mesh mt1:N --G G --kappa-b-hat KB --t-end T --no-plot` "
              "(boundary integral method, Cash-Karp with relative tolerance 1e-7 and absolute tolerance "
              "1e-6 R). Units: G = mu gamma R / kS and kB_hat = kB / (R^2 kS) with the neo-Hookean "
              "modulus kS of eq. (18), which is three times the shear modulus Gs: the capillary number "

@@ -1,24 +1,21 @@
 // bendlab shear: an initially spherical capsule (neo-Hookean membrane + bending) in linear shear
-// flow, boundary integral method (paper section 4).
-//
-// Output folder:
-//   timeseries.csv   gamma_t,D,theta,volume,area,E_bend,E_elastic,dt   (one row per accepted step,
-//                    flushed as the run goes)
-//   snapshot_NNNNN.vtp + shapes.pvd   shapes every --snapshot-every (ParaView collection)
-//   checkpoint.json  the state at the last snapshot, for --resume
-//   summary.json     D_steady, theta_steady, mean_gamma_dt, steps, wall_seconds, ...
-//   D_theta.png      D and theta against gamma t (scripts/plot_shear.py)
+// flow, boundary integral method (paper section 4). Argument parsing only: the membrane is a
+// MembraneModel, the flow a BimCapsuleSolver, and the run folder (timeseries.csv, snapshots,
+// checkpoint.json, summary.json) belongs to run_capsule (bendlab/capsule/capsule_run.hpp).
+// D_theta.png is drawn by scripts/plot_shear.py, found at run time.
 #include <fmt/format.h>
 
-#include <chrono>
 #include <filesystem>
-#include <fstream>
-#include <nlohmann/json.hpp>
+#include <iostream>
+#include <optional>
 #include <regex>
 
 #include "bendlab/bending/bending_method.hpp"
-#include "bendlab/core/atomic_file.hpp"
-#include "bendlab/flow/shear_simulation.hpp"
+#include "bendlab/capsule/capsule_run.hpp"
+#include "bendlab/core/helper_program.hpp"
+#include "bendlab/capsule/shear_units.hpp"
+#include "bendlab/flow/bim/bim_capsule_solver.hpp"
+#include "bendlab/integrate/cash_karp.hpp"
 #include "bendlab/mesh/generators.hpp"
 #include "bendlab/mesh/mesh_io.hpp"
 #include "cli_common.hpp"
@@ -31,9 +28,11 @@ namespace bendlab::cli {
 namespace {
 
 struct ShearArgs {
-  std::string solver = "bim", method = "none", mesh = "mt1:1280", out;
-  double G = 0.1, kappa_b = 0, t_end = 10, snapshot_every = 0.5, rtol = 1e-7, atol = 1e-6;
+  std::string solver = "bim", method = "none", mesh = "mt1:1280", out, plot_script;
+  double G = 0.1, t_end = 10, snapshot_every = 0.5, rtol = 1e-7, atol = 1e-6;
+  std::optional<double> kappa_b_hat, kappa_b;
   int rings = 0;
+  std::int64_t stop_after_steps = 0;
   bool resume = false, plot = true;
 };
 
@@ -56,199 +55,81 @@ TriMesh capsule_mesh(const std::string& spec) {
   return read_mesh(spec);
 }
 
-/// D_steady, theta_steady and mean_gamma_dt over gamma t in [5, 10], or over the last half of
-/// the run when it ends before gamma t = 10 (table 4 and figure 12b of the paper).
-struct Window {
-  double begin, end;
-};
-Window steady_window(double t_end) { return t_end >= 10 ? Window{5, 10} : Window{t_end / 2, t_end}; }
-
-struct Row {
-  double t, D, theta, volume, area, E_bend, E_elastic, dt;
-};
-
-std::vector<Row> read_timeseries(const fs::path& path) {
-  std::vector<Row> rows;
-  std::ifstream in(path);
-  std::string line;
-  std::getline(in, line);  // header
-  while (std::getline(in, line)) {
-    Row r{};
-    std::replace(line.begin(), line.end(), ',', ' ');
-    std::istringstream s(line);
-    std::string eb;
-    if (s >> r.t >> r.D >> r.theta >> r.volume >> r.area >> eb >> r.E_elastic >> r.dt) {
-      r.E_bend = eb == "nan" ? std::numeric_limits<double>::quiet_NaN() : std::stod(eb);
-      rows.push_back(r);
-    }
+/// D_theta.png from scripts/plot_shear.py (--plot-script, else found at run time: an install's
+/// share/bendlab/scripts, or scripts/ above the executable), started with an argument vector.
+void plot(const ShearArgs& a) {
+  const fs::path script = find_helper_script("plot_shear.py", a.plot_script);
+  if (script.empty() || !fs::is_regular_file(script)) {
+    note(a.plot_script.empty() ? "warning: the plot was not made (scripts/plot_shear.py not found; see --plot-script)"
+                               : fmt::format("warning: the plot was not made (--plot-script '{}' not found)",
+                                             a.plot_script));
+    return;
   }
-  return rows;
-}
-
-const char* kHeader = "gamma_t,D,theta,volume,area,E_bend,E_elastic,dt";
-
-std::string format_row(const Row& r) {
-  return fmt::format("{:.10g},{:.12g},{:.12g},{:.15g},{:.15g},{},{:.12g},{:.6g}\n", r.t, r.D, r.theta, r.volume,
-                     r.area, std::isnan(r.E_bend) ? std::string("nan") : fmt::format("{:.12g}", r.E_bend),
-                     r.E_elastic, r.dt);
-}
-
-nlohmann::json points_to_json(const Points& x) {
-  std::vector<double> flat(x.data(), x.data() + x.size());
-  return flat;
-}
-
-Points points_from_json(const nlohmann::json& j, Eigen::Index n) {
-  const auto flat = j.get<std::vector<double>>();
-  if (static_cast<Eigen::Index>(flat.size()) != 3 * n)
-    throw Error(fmt::format("checkpoint has {} coordinates, the mesh needs {}", flat.size(), 3 * n));
-  Points x(n, 3);
-  std::copy(flat.begin(), flat.end(), x.data());
-  return x;
-}
-
-/// The arguments a resumed run must share with the run it continues.
-nlohmann::json run_identity(const ShearArgs& a) {
-  return {{"method", a.method}, {"rings", a.rings}, {"mesh", a.mesh}, {"G", a.G}, {"kappa_b", a.kappa_b}};
+  if (run_helper_program({"/usr/bin/python3", script.string(), a.out}) != 0)
+    note("warning: the plot was not made (needs /usr/bin/python3 with matplotlib)");
 }
 
 void run_shear(const ShearArgs& a) {
   // Everything is checked before any work starts.
   require_positive("--G", a.G);
-  require_positive("--kappa-b", a.kappa_b, true);
+  if (a.kappa_b_hat) require_positive("--kappa-b-hat", *a.kappa_b_hat, true);
+  if (a.kappa_b) require_positive("--kappa-b", *a.kappa_b, true);
   require_positive("--t-end", a.t_end);
   require_positive("--snapshot-every", a.snapshot_every);
   require_positive("--rtol", a.rtol);
   require_positive("--atol", a.atol);
-  if (a.method == "none" && a.kappa_b > 0)
-    throw Error("--kappa-b > 0 needs a bending --method (" + method_names_joined() + ")");
-  std::unique_ptr<BendingMethod> bending;
+  const ShearUnits units = ShearUnits::from(a.G, a.kappa_b_hat, a.kappa_b);
+  if (a.method == "none" && units.kappa_b_hat > 0)
+    throw Error("--kappa-b-hat or --kappa-b > 0 needs a bending --method (" + method_names_joined() + ")");
+  std::shared_ptr<const BendingMethod> bending;
   if (a.method != "none") {
     MethodOptions options;
     if (a.rings != 0) options["rings"] = std::to_string(a.rings);
     bending = make_bending_method(a.method, options);
   }
-  const fs::path out = a.out;
-  if (fs::exists(out) && !fs::is_directory(out)) throw Error(fmt::format("--out '{}' is a file, not a folder", a.out));
-  const fs::path checkpoint = out / "checkpoint.json";
-  if (a.resume && !fs::exists(checkpoint))
+  if (fs::exists(a.out) && !fs::is_directory(a.out)) throw Error(fmt::format("--out '{}' is a file, not a folder", a.out));
+  if (a.resume && !fs::exists(fs::path(a.out) / "checkpoint.json"))
     throw Error(fmt::format("--resume: no checkpoint in '{}' to resume from", a.out));
   const TriMesh mesh = capsule_mesh(a.mesh);
-  fs::create_directories(out);
 
-  ShearParameters params{a.G, a.kappa_b, a.t_end, a.rtol, a.atol};
-  ShearSimulation sim(mesh, params, bending.get());
+  MembraneParameters mp;
+  mp.kS = units.kS();
+  mp.kB = units.kB();
+  mp.bending = bending;
+  auto membrane = std::make_shared<const MembraneModel>(mesh, mp);
+  CashKarpOptions ck;
+  ck.rtol = a.rtol;
+  ck.atol = a.atol;
+  BimOptions bim;
+  bim.mu = ShearUnits::mu;
+  bim.gamma = ShearUnits::gamma;
+  BimCapsuleSolver solver(membrane, std::make_unique<CashKarp>(ck), bim);
 
-  std::vector<std::pair<double, std::string>> snapshots;
-  std::int64_t steps_before = 0;
-  double wall_before = 0;
-  if (a.resume) {
-    const auto j = nlohmann::json::parse(std::ifstream(checkpoint));
-    if (j.at("arguments") != run_identity(a))
-      throw Error(fmt::format("--resume: --method, --mesh, --G or --kappa-b differ from the run in '{}' ({})", a.out,
-                              j.at("arguments").dump()));
-    sim.restart(points_from_json(j.at("positions"), mesh.num_vertices()), j.at("time"), j.at("dt_next"));
-    snapshots = j.at("snapshots").get<decltype(snapshots)>();
-    steps_before = j.at("steps");
-    wall_before = j.at("wall_seconds");
-    note(fmt::format("resuming at gamma t = {:.4g} from {}", sim.time(), checkpoint.string()));
-  }
-
-  // The time series: on resume keep the rows up to the checkpoint, then append.
-  const fs::path series_path = out / "timeseries.csv";
-  std::vector<Row> rows;
-  if (a.resume) {
-    for (const Row& r : read_timeseries(series_path))
-      if (r.t <= sim.time() * (1 + 1e-12)) rows.push_back(r);
-  }
-  std::ofstream series(series_path, std::ios::trunc);
-  if (!series) throw Error(fmt::format("cannot write '{}'", series_path.string()));
-  series << kHeader << '\n';
-  for (const Row& r : rows) series << format_row(r);
-  series.flush();
-
-  const auto start = std::chrono::steady_clock::now();
-  auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
-  double last_progress = -1e9;
-  const double t_start = sim.time();
-  double next_snapshot = snapshots.empty() ? 0.0 : snapshots.back().first + a.snapshot_every;
-
-  auto write_snapshot = [&](const Points& x, double t, double dt_next, std::int64_t steps) {
-    const std::string name = fmt::format("snapshot_{:05d}.vtp", static_cast<int>(snapshots.size()));
-    write_mesh(out / name, sim.topology(), x);
-    snapshots.emplace_back(t, name);
-    write_pvd(out / "shapes.pvd", snapshots);
-    nlohmann::json j = {
-        {"arguments", run_identity(a)},
-        {"time", t}, {"dt_next", dt_next}, {"steps", steps}, {"wall_seconds", wall_before + elapsed()},
-        {"snapshots", snapshots}, {"positions", points_to_json(x)}};
-    AtomicFile f(checkpoint);
-    f.stream() << j.dump();
-    f.commit();
+  CapsuleRunOptions o;
+  o.folder = a.out;
+  o.t_end = a.t_end;
+  o.snapshot_every = a.snapshot_every;
+  o.resume = a.resume;
+  o.stop_after_steps = a.stop_after_steps;
+  o.arguments = {{"solver", a.solver}, {"method", a.method},  {"rings", a.rings},
+                 {"mesh", a.mesh},     {"G", units.G},        {"kappa_b_hat", units.kappa_b_hat},
+                 {"kappa_b", units.kappa_b()}};
+  o.summary_fields = {{"rtol", a.rtol}, {"atol", a.atol}};
+  o.on_note = note;
+  o.on_progress = [](const CapsuleProgress& p) {
+    note(fmt::format("gamma t = {:7.4f} / {:g} ({:3.0f}%)  steps {:6d}  gamma dt {:.2e}  D {:.5f}  theta {:.4f}  "
+                     "elapsed {:.0f} s  ETA {:.0f} s",
+                     p.time, p.t_end, 100 * (p.time - p.t_start) / (p.t_end - p.t_start), p.steps, p.dt, p.D,
+                     p.theta, p.elapsed_seconds, p.eta_seconds));
   };
-  if (!a.resume) write_snapshot(sim.positions(), sim.time(), 0, 0);
-  next_snapshot = snapshots.back().first + a.snapshot_every;
-
-  std::int64_t steps = steps_before;
-  const CashKarpStats stats = sim.run([&](const ShearSample& s) {
-    ++steps;
-    const Row r{s.time, s.D, s.theta, s.volume, s.area, s.E_bend ? *s.E_bend : std::numeric_limits<double>::quiet_NaN(),
-                s.E_elastic, s.dt};
-    rows.push_back(r);
-    series << format_row(r);
-    series.flush();
-    if (s.time >= next_snapshot - 1e-9 * a.snapshot_every || s.time >= a.t_end - 1e-12) {
-      write_snapshot(*s.positions, s.time, s.dt_next, steps);
-      next_snapshot += a.snapshot_every;
-    }
-    const double now = elapsed();
-    if (now - last_progress >= 2.0 || s.time >= a.t_end - 1e-12) {
-      last_progress = now;
-      const double done = (s.time - t_start) / (a.t_end - t_start);
-      const double eta = done > 0 ? now * (1 - done) / done : 0;
-      note(fmt::format("gamma t = {:7.4f} / {:g} ({:3.0f}%)  steps {:6d}  gamma dt {:.2e}  D {:.5f}  theta {:.4f}  "
-                       "elapsed {:.0f} s  ETA {:.0f} s",
-                       s.time, a.t_end, 100 * done, steps, s.dt, s.D, s.theta, now, eta));
-    }
-    return true;
-  });
-  series.close();
-
-  // Summary over the steady window.
-  const Window w = steady_window(a.t_end);
-  double weight = 0, D = 0, theta = 0, dt_sum = 0;
-  int dt_count = 0;
-  for (size_t k = 0; k < rows.size(); ++k) {
-    if (rows[k].t < w.begin || rows[k].t > w.end + 1e-12) continue;
-    // Each row's values hold over the step that led to it: dt-weighted time average.
-    D += rows[k].D * rows[k].dt;
-    theta += rows[k].theta * rows[k].dt;
-    weight += rows[k].dt;
-    dt_sum += rows[k].dt;
-    ++dt_count;
+  const CapsuleRunResult result = run_capsule(solver, o);
+  if (!result.finished) {
+    note(fmt::format("stopped after {} steps at gamma t = {:.6g}; continue with --resume", a.stop_after_steps,
+                     solver.time()));
+    return;
   }
-  nlohmann::json summary = {
-      {"solver", a.solver}, {"method", a.method}, {"mesh", a.mesh},
-      {"vertices", mesh.num_vertices()}, {"triangles", mesh.num_faces()},
-      {"G", a.G}, {"kappa_b_hat", a.kappa_b}, {"t_end", a.t_end}, {"rtol", a.rtol}, {"atol", a.atol},
-      {"steady_window", {w.begin, w.end}},
-      {"D_steady", weight > 0 ? D / weight : std::numeric_limits<double>::quiet_NaN()},
-      {"theta_steady", weight > 0 ? theta / weight : std::numeric_limits<double>::quiet_NaN()},
-      {"mean_gamma_dt", dt_count > 0 ? dt_sum / dt_count : std::numeric_limits<double>::quiet_NaN()},
-      {"steps", steps}, {"rejected_steps", stats.rejected}, {"velocity_evaluations", stats.rhs_evaluations},
-      {"final_volume", rows.empty() ? sim.initial_volume() : rows.back().volume},
-      {"initial_volume", sim.initial_volume()},
-      {"wall_seconds", wall_before + elapsed()}};
-  if (weight > 0 && !std::isfinite(summary["D_steady"].get<double>())) summary["D_steady"] = nullptr;
-  AtomicFile f(out / "summary.json");
-  f.stream() << summary.dump(2) << '\n';
-  f.commit();
-  std::cout << summary.dump() << std::endl;
-
-  if (a.plot) {
-    const std::string cmd = fmt::format("/usr/bin/python3 '{}/scripts/plot_shear.py' '{}'", BENDLAB_SOURCE_DIR, out.string());
-    if (std::system(cmd.c_str()) != 0) note("warning: the plot was not made (needs /usr/bin/python3 with matplotlib)");
-  }
+  std::cout << result.summary.dump() << std::endl;
+  if (a.plot) plot(a);
 }
 
 const CommandRegistration registration([](CLI::App& app) {
@@ -263,15 +144,25 @@ const CommandRegistration registration([](CLI::App& app) {
   cmd->add_option("--mesh", args->mesh, "mt1:N or mt2:N (N triangles: 320, 1280, 5120, ...), inh:mt1 or inh:mt2 "
                                         "(320 triangles + 3 Rivara passes), or a mesh file (.off, .obj, .ply)")
       ->capture_default_str();
-  cmd->add_option("--G", args->G, "dimensionless shear rate mu gamma R / kS")->capture_default_str();
-  cmd->add_option("--kappa-b", args->kappa_b, "dimensionless bending modulus kB / (R^2 kS)")->capture_default_str();
+  cmd->add_option("--G", args->G, "dimensionless shear rate mu gamma R / kS (units R = mu = gamma = 1, kS = 1/G)")
+      ->capture_default_str();
+  auto* hat = cmd->add_option("--kappa-b-hat", args->kappa_b_hat,
+                              "dimensionless bending modulus kappa_b_hat = kB / (R^2 kS) (default 0)");
+  auto* dim = cmd->add_option("--kappa-b", args->kappa_b,
+                              "dimensional bending modulus kB = kappa_b_hat / G (R = mu = gamma = 1)");
+  hat->excludes(dim);
   cmd->add_option("--t-end", args->t_end, "end of the run in gamma t")->capture_default_str();
   cmd->add_option("--rtol", args->rtol, "relative tolerance of the Cash-Karp stepper")->capture_default_str();
   cmd->add_option("--atol", args->atol, "absolute tolerance of the Cash-Karp stepper, in units of R")->capture_default_str();
   cmd->add_option("--snapshot-every", args->snapshot_every, "gamma t between .vtp snapshots and checkpoints")
       ->capture_default_str();
   cmd->add_flag("--resume", args->resume, "continue the run in --out from its last checkpoint");
+  cmd->add_option("--stop-after-steps", args->stop_after_steps,
+                  "stop after this many accepted steps (no summary; continue with --resume)")
+      ->check(CLI::NonNegativeNumber);
   cmd->add_flag("!--no-plot", args->plot, "do not draw D_theta.png");
+  cmd->add_option("--plot-script", args->plot_script,
+                  "plot_shear.py to draw D_theta.png with (default: found beside the executable)");
   cmd->add_option("--out", args->out, "output folder (created if missing)")->required();
   cmd->callback([args] { run_shear(*args); });
 });

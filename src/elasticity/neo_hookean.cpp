@@ -27,9 +27,6 @@ NeoHookean::NeoHookean(TopologyPtr topology, const Points& reference, double kS)
     m11_[f] = g00 / det;
     reference_area_ += a0_[f];
   }
-  grad1_.resize(nf, 3);
-  grad2_.resize(nf, 3);
-  face_energy_.resize(nf);
 }
 
 double NeoHookean::energy(const Points& x) const {
@@ -55,6 +52,9 @@ double NeoHookean::energy_and_forces(const Points& x, Points& force) const {
   const int nf = t.num_faces(), nv = t.num_vertices();
   if (force.rows() != nv) force.resize(nv, 3);
   const double c = kS_ / 6.0;
+  // Per face: the energy gradient with respect to corners 1 and 2 (corner 0 is minus their sum).
+  // Allocated per call, so that concurrent calls on one object are safe.
+  Points grad1(nf, 3), grad2(nf, 3);
   double e = 0;
 #pragma omp parallel for reduction(+ : e) schedule(static)
   for (int f = 0; f < nf; ++f) {
@@ -70,8 +70,8 @@ double NeoHookean::energy_and_forces(const Points& x, Points& force) const {
     const double k = a0_[f] * c, q = 2 * s / (detC * detC);
     const Vec3 d1 = k * (2 * (m00_[f] * e1 + m01_[f] * e2) - q * (g11 * e1 - g01 * e2));
     const Vec3 d2 = k * (2 * (m11_[f] * e2 + m01_[f] * e1) - q * (g00 * e2 - g01 * e1));
-    grad1_.row(f) = d1.transpose();
-    grad2_.row(f) = d2.transpose();
+    grad1.row(f) = d1.transpose();
+    grad2.row(f) = d2.transpose();
   }
   // Gather per vertex over its one-ring faces (CSR), so no two threads write one vertex.
   const auto& rf = t.ring_faces();
@@ -82,9 +82,9 @@ double NeoHookean::energy_and_forces(const Points& x, Points& force) const {
     for (int k = t.ring_begin(i); k < t.ring_end(i); ++k) {
       const int f = rf[k];
       switch (rc[k]) {
-        case 0: g -= grad1_.row(f) + grad2_.row(f); break;
-        case 1: g += grad1_.row(f); break;
-        default: g += grad2_.row(f); break;
+        case 0: g -= grad1.row(f) + grad2.row(f); break;
+        case 1: g += grad1.row(f); break;
+        default: g += grad2.row(f); break;
       }
     }
     force.row(i) = -g;

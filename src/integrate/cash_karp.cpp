@@ -60,10 +60,12 @@ double CashKarp::error_norm(const State& y, const State& y5, const State& err) c
   return std::isfinite(e) ? e : std::numeric_limits<double>::infinity();
 }
 
-CashKarpStats CashKarp::integrate(const Rhs& rhs, double t0, double t1, State& y, double dt0,
-                                  const OnAccept& on_accept) {
+IntegratorStats CashKarp::integrate(const Rhs& rhs, double t0, double t1, State& y, double dt0,
+                                    const OnAccept& on_accept) {
   if (!(t1 > t0)) throw Error(fmt::format("Cash-Karp: end time {} must be after start time {}", t1, t0));
-  CashKarpStats st;
+  // The counts live in the member, so that on_accept can read them during the integration.
+  IntegratorStats& st = stats_;
+  st = IntegratorStats{};
   st.t = t0;
   double dt = std::min(dt0 > 0 ? dt0 : options_.dt_initial, options_.dt_max);
   proposed_ = dt;

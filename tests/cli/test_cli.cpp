@@ -217,8 +217,11 @@ TEST_F(Cli, ShearRefusesBadParametersBeforeWork) {
   expect_refused(run("shear --G -0.1 --out " + out.string()), "--G", out);
   expect_refused(run("shear --G inf --out " + out.string()), "--G", out);
   expect_refused(run("shear --method C --kappa-b nan --out " + out.string()), "--kappa-b", out);
+  expect_refused(run("shear --method C --kappa-b-hat -1 --out " + out.string()), "--kappa-b-hat", out);
+  expect_refused(run("shear --method C --kappa-b-hat 0.1 --kappa-b 1 --out " + out.string()), "excludes", out);
   expect_refused(run("shear --t-end -1 --out " + out.string()), "--t-end", out);
   expect_refused(run("shear --kappa-b 0.1 --out " + out.string()), "--method", out);
+  expect_refused(run("shear --kappa-b-hat 0.1 --out " + out.string()), "--method", out);
   expect_refused(run("shear --mesh mt1:1000 --out " + out.string()), "1000", out);
   expect_refused(run("shear --mesh " + (dir / "missing.off").string() + " --out " + out.string()), "missing.off", out);
   write(dir / "open.off", off(kTetraVertices, "3 0 2 1\n3 0 1 3\n3 0 3 2\n", 4, 3));
@@ -244,7 +247,7 @@ TEST_F(Cli, ShearWritesItsFilesAndResumes) {
   const std::string last = series.substr(series.rfind('\n', series.size() - 2) + 1);
   EXPECT_NEAR(std::stod(last.substr(0, last.find(','))), 0.5, 1e-12);
   // A resume with other physics is refused.
-  expect_refused(run("shear --mesh mt1:320 --G 0.2 --t-end 0.6 --resume --out " + out.string()), "--G",
+  expect_refused(run("shear --mesh mt1:320 --G 0.2 --t-end 0.6 --resume --out " + out.string()), "G is 0.2 here",
                  out / "nothing");
 }
 
@@ -259,4 +262,42 @@ TEST_F(Cli, ComparingWithASurfaceTheNodesAreNotOnIsRefused) {
                  "do not lie on the rbc surface", shape);
   // The same mesh against the surface it was made for is accepted.
   EXPECT_EQ(run("forces --mesh " + sphere.string() + " --method C --shape sphere --out " + out.string()).status, 0);
+}
+
+TEST_F(Cli, ShearStoppedAndResumedEqualsUninterrupted) {
+  const std::string common = " --mesh mt1:320 --G 0.1 --t-end 0.3 --snapshot-every 0.1 --no-plot --out ";
+  const fs::path full = dir / "full", parts = dir / "parts";
+  CliRun r = run("shear" + common + full.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  r = run("shear --stop-after-steps 4" + common + parts.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("stopped after 4 steps"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(parts / "summary.json"));
+  r = run("shear --resume" + common + parts.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(slurp(parts / "timeseries.csv"), slurp(full / "timeseries.csv"));
+  auto a = nlohmann::json::parse(slurp(full / "summary.json"));
+  auto b = nlohmann::json::parse(slurp(parts / "summary.json"));
+  a.erase("wall_seconds");
+  b.erase("wall_seconds");
+  EXPECT_EQ(a, b);
+}
+
+TEST_F(Cli, ShearModuliAndMissingPlotScript) {
+  // --kappa-b is dimensional: kB = kappa_b_hat / G with R = mu = gamma = 1.
+  const fs::path out = dir / "run";
+  CliRun r = run("shear --method C --mesh mt1:320 --G 0.1 --kappa-b 0.375 --t-end 0.005 --plot-script " +
+                 (dir / "missing.py").string() + " --out " + out.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("warning: the plot was not made"), std::string::npos) << r.err;
+  const auto summary = nlohmann::json::parse(slurp(out / "summary.json"));
+  EXPECT_NEAR(summary["kappa_b_hat"].get<double>(), 0.0375, 1e-15);
+  EXPECT_NEAR(summary["kappa_b"].get<double>(), 0.375, 1e-14);
+  const auto checkpoint = nlohmann::json::parse(slurp(out / "checkpoint.json"));
+  EXPECT_EQ(checkpoint["arguments"]["kappa_b_hat"], summary["kappa_b_hat"]);
+  EXPECT_EQ(checkpoint["version"], 2);
+  // The same run given kappa_b_hat resumes it (the same physics).
+  r = run("shear --method C --mesh mt1:320 --G 0.1 --kappa-b-hat 0.0375 --t-end 0.006 --no-plot --resume --out " +
+          out.string());
+  EXPECT_EQ(r.status, 0) << r.err;
 }

@@ -13,27 +13,29 @@
 // edge vectors x1 - x0, x2 - x0. So no local frame is built and the energy is invariant under
 // rigid motions by construction; forces therefore sum to zero and exert no torque.
 #include "bendlab/core/types.hpp"
+#include "bendlab/elasticity/elastic_law.hpp"
 #include "bendlab/mesh/topology.hpp"
 
 namespace bendlab {
 
-class NeoHookean {
+class NeoHookean final : public ElasticLaw {
  public:
   /// kS: the modulus of eq. (18) (three times the shear modulus, CONVENTIONS.md section 2).
   /// Throws bendlab::Error for a reference triangle of zero area or a non-positive kS.
   NeoHookean(TopologyPtr topology, const Points& reference, double kS);
 
+  std::string name() const override { return "neo-Hookean"; }
   /// E_S of eq. (20) for the current positions x (N x 3).
-  double energy(const Points& x) const;
-  /// Node forces F = -dE_S/dx into `force`, which must already be N x 3 (it is overwritten).
-  /// Uses an internal per-face buffer: do not call concurrently on one object.
-  void forces(const Points& x, Points& force) const;
+  double energy(const Points& x) const override;
+  /// Node forces F = -dE_S/dx into `force` (resized to N x 3, overwritten). Scratch is allocated
+  /// per call: concurrent calls on one object are safe.
+  void forces(const Points& x, Points& force) const override;
   /// Energy and forces in one pass; returns E_S.
-  double energy_and_forces(const Points& x, Points& force) const;
+  double energy_and_forces(const Points& x, Points& force) const override;
 
-  double kS() const { return kS_; }
+  double kS() const override { return kS_; }
   double reference_area() const { return reference_area_; }
-  const Topology& topology() const { return *topology_; }
+  const Topology& topology() const override { return *topology_; }
 
  private:
   TopologyPtr topology_;
@@ -41,9 +43,6 @@ class NeoHookean {
   double reference_area_ = 0;
   // Per face: A0 and the inverse reference metric (G0^-1)_{00}, _{01}, _{11}.
   Scalars a0_, m00_, m01_, m11_;
-  // Per face: the energy gradient with respect to corners 1 and 2 (corner 0 is minus their sum).
-  mutable Points grad1_, grad2_;
-  mutable Scalars face_energy_;
 };
 
 }  // namespace bendlab

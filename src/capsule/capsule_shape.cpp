@@ -1,4 +1,4 @@
-#include "bendlab/flow/capsule_shape.hpp"
+#include "bendlab/capsule/capsule_shape.hpp"
 
 #include <fmt/format.h>
 

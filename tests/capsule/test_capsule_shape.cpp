@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "bendlab/flow/capsule_shape.hpp"
+#include "bendlab/capsule/capsule_shape.hpp"
 #include "bendlab/mesh/generators.hpp"
 
 using namespace bendlab;

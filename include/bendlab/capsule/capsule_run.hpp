@@ -1,0 +1,75 @@
+#pragma once
+// A capsule run: drives a CapsuleSolver from its current state to t_end and keeps the run folder.
+//
+//   timeseries.csv   one row per accepted step (time_series.hpp), append-only, flushed per row
+//   snapshot_NNNNN.vtp + shapes.pvd   the shape every snapshot_every (and at t_end)
+//   checkpoint.json  the state at the last snapshot (checkpoint.hpp), for resume
+//   summary.json     the arguments, the steady statistics (steady_statistics.hpp), counters,
+//                    volumes and wall_seconds
+//
+// A resumed run (options.resume) validates checkpoint.json as a whole, checks that its arguments
+// equal options.arguments, truncates timeseries.csv to the checkpoint's rows (atomic rewrite),
+// restores the solver and continues; its summary.json then equals the uninterrupted run's exactly,
+// except "wall_seconds" (the wall time of all parts; a clock, not a result). If t_end changed so
+// that the steady window moved, the window's sums are recomputed from timeseries.csv (to the
+// precision of the file: dt has 6 digits, so about 1e-6 relative) and a note says so.
+//
+// Every write is checked: a failed write throws bendlab::Error naming the file, and the last
+// complete checkpoint stays in place. Nothing here prints: progress and notes go to callbacks.
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "bendlab/capsule/capsule_solver.hpp"
+#include "bendlab/capsule/time_series.hpp"
+
+namespace bendlab {
+
+struct CapsuleProgress {
+  double time = 0, t_start = 0, t_end = 0;  ///< gamma t now, at the start of this part, at the end
+  double dt = 0;                            ///< the last step
+  double D = 0, theta = 0;
+  std::int64_t steps = 0;                   ///< accepted steps of the whole run
+  double elapsed_seconds = 0;               ///< wall time of this part
+  double eta_seconds = 0;                   ///< estimated wall time to t_end
+  bool final = false;                       ///< the report at t_end
+};
+
+struct CapsuleRunOptions {
+  std::filesystem::path folder;  ///< run folder (created if missing)
+  double t_end = 10;             ///< gamma t
+  double snapshot_every = 0.5;   ///< gamma t between snapshots and checkpoints
+  bool resume = false;           ///< continue from folder/checkpoint.json
+  /// The run's identity: must be equal (numbers to 1e-12 relative) when resuming; copied into
+  /// checkpoint.json and summary.json.
+  nlohmann::json arguments = nlohmann::json::object();
+  /// Further fields of summary.json that may change between parts (tolerances, mesh label, ...).
+  nlohmann::json summary_fields = nlohmann::json::object();
+  /// Stop (without a summary) after this many accepted steps of this part; 0: never. The run can
+  /// then be resumed from its last checkpoint (how tests interrupt a run).
+  std::int64_t stop_after_steps = 0;
+  double progress_interval_seconds = 2;  ///< wall time between progress reports
+  std::function<void(const CapsuleProgress&)> on_progress;
+  std::function<void(const std::string&)> on_note;
+};
+
+struct CapsuleRunResult {
+  bool finished = false;   ///< reached t_end (false: stopped by stop_after_steps)
+  nlohmann::json summary;  ///< summary.json's content (when finished)
+};
+
+/// The time-series row of positions x at time t after a step dt: D and theta of the equivalent
+/// ellipsoid (capsule_shape.hpp), volume, area and the membrane's energies.
+TimeSeriesRow capsule_sample(const MembraneModel& membrane, const Points& x, double t, double dt);
+
+/// Runs `solver` as described above. Throws bendlab::Error (before any file changes for bad
+/// options or a refused checkpoint).
+CapsuleRunResult run_capsule(CapsuleSolver& solver, const CapsuleRunOptions& options);
+
+/// Whether two argument sets are equal (same keys; numbers to 1e-12 relative); otherwise the first
+/// difference in words ("G is 0.2 here but 0.1 in the checkpoint").
+std::string compare_arguments(const nlohmann::json& here, const nlohmann::json& saved);
+
+}  // namespace bendlab

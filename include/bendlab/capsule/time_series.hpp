@@ -1,0 +1,56 @@
+#pragma once
+// The time series of a capsule run, timeseries.csv:
+//   gamma_t,D,theta,volume,area,E_bend,E_elastic,dt
+// one row per accepted step; E_bend is `nan` where the bending method has no energy (or none).
+//
+// The file is append-only during a run and flushed after every row; every write is checked (a
+// failed write throws bendlab::Error naming the file). Rewrites (resume: keep the rows up to the
+// checkpoint) go through a temporary file and an atomic rename, so the file is never half-written.
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "bendlab/core/types.hpp"
+
+namespace bendlab {
+
+struct TimeSeriesRow {
+  double t = 0, D = 0, theta = 0, volume = 0, area = 0;
+  double E_bend = 0;  ///< NaN where undefined
+  double E_elastic = 0, dt = 0;
+};
+
+/// The header line (without newline).
+const char* time_series_header();
+/// One row as written, with its newline.
+std::string format_time_series_row(const TimeSeriesRow& row);
+/// All rows of a time series file; throws bendlab::Error naming the file and line for a missing
+/// file, a wrong header or a malformed row.
+std::vector<TimeSeriesRow> read_time_series(const std::filesystem::path& path);
+
+class TimeSeriesFile {
+ public:
+  /// A new file holding only the header (replacing any file at path, atomically).
+  static TimeSeriesFile create(const std::filesystem::path& path);
+  /// Keeps the header and the first `rows` rows of an existing file, byte for byte (atomic
+  /// rewrite), then appends after them. Throws if the file is missing, its header differs or it
+  /// has fewer rows.
+  static TimeSeriesFile resume(const std::filesystem::path& path, std::int64_t rows);
+  /// Appends to path as it is (no header check); for tests of failing devices.
+  static TimeSeriesFile append_to(const std::filesystem::path& path, std::int64_t rows = 0);
+
+  /// Appends one row and flushes; throws bendlab::Error if the write fails.
+  void append(const TimeSeriesRow& row);
+  std::int64_t rows() const { return rows_; }
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  TimeSeriesFile(std::filesystem::path path, std::int64_t rows);
+  std::filesystem::path path_;
+  std::ofstream out_;
+  std::int64_t rows_ = 0;
+};
+
+}  // namespace bendlab

@@ -1,0 +1,216 @@
+#include "bendlab/capsule/capsule_run.hpp"
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <set>
+
+#include "bendlab/capsule/capsule_shape.hpp"
+#include "bendlab/capsule/checkpoint.hpp"
+#include "bendlab/core/atomic_file.hpp"
+#include "bendlab/geometry/measures.hpp"
+#include "bendlab/mesh/mesh_io.hpp"
+
+namespace fs = std::filesystem;
+
+namespace bendlab {
+
+TimeSeriesRow capsule_sample(const MembraneModel& membrane, const Points& x, double t, double dt) {
+  TimeSeriesRow r;
+  r.t = t;
+  r.dt = dt;
+  const CapsuleShape shape = capsule_shape(membrane.topology(), x);
+  r.D = shape.D;
+  r.theta = shape.theta;
+  r.volume = shape.volume;
+  r.area = surface_area(membrane.topology(), x);
+  const std::optional<double> eb = membrane.bending_energy(x);
+  r.E_bend = eb ? *eb : std::numeric_limits<double>::quiet_NaN();
+  r.E_elastic = membrane.elastic_energy(x);
+  return r;
+}
+
+std::string compare_arguments(const nlohmann::json& here, const nlohmann::json& saved) {
+  for (const auto& [key, value] : here.items()) {
+    if (!saved.contains(key)) return fmt::format("{} is {} here but missing in the checkpoint", key, value.dump());
+    const auto& other = saved.at(key);
+    const bool same = value.is_number() && other.is_number()
+                          ? std::abs(value.get<double>() - other.get<double>()) <=
+                                1e-12 * std::max(std::abs(value.get<double>()), std::abs(other.get<double>()))
+                          : value == other;
+    if (!same) return fmt::format("{} is {} here but {} in the checkpoint", key, value.dump(), other.dump());
+  }
+  for (const auto& [key, value] : saved.items())
+    if (!here.contains(key)) return fmt::format("{} is {} in the checkpoint but not given here", key, value.dump());
+  return {};
+}
+
+namespace {
+
+void check_options(const CapsuleRunOptions& o) {
+  if (o.folder.empty()) throw Error("capsule run: no output folder");
+  if (!(o.t_end > 0) || !std::isfinite(o.t_end))
+    throw Error(fmt::format("capsule run: t_end must be positive, got {}", o.t_end));
+  if (!(o.snapshot_every > 0) || !std::isfinite(o.snapshot_every))
+    throw Error(fmt::format("capsule run: snapshot_every must be positive, got {}", o.snapshot_every));
+  if (o.stop_after_steps < 0) throw Error("capsule run: stop_after_steps must be >= 0");
+  if (!o.arguments.is_object() || !o.summary_fields.is_object())
+    throw Error("capsule run: arguments and summary_fields must be JSON objects");
+  if (fs::exists(o.folder) && !fs::is_directory(o.folder))
+    throw Error(fmt::format("'{}' is a file, not a folder", o.folder.string()));
+}
+
+nlohmann::json finite_or_null(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+
+}  // namespace
+
+CapsuleRunResult run_capsule(CapsuleSolver& solver, const CapsuleRunOptions& o) {
+  check_options(o);
+  const MembraneModel& membrane = solver.membrane();
+  const fs::path folder = o.folder;
+  const fs::path checkpoint_path = folder / "checkpoint.json";
+  const fs::path series_path = folder / "timeseries.csv";
+  auto note = [&](const std::string& s) {
+    if (o.on_note) o.on_note(s);
+  };
+
+  // State carried by the checkpoint.
+  CapsuleCheckpoint state;
+  state.arguments = o.arguments;
+  state.solver = solver.name();
+  state.steady = SteadyStatistics(SteadyWindow::for_run(o.t_end));
+
+  std::optional<TimeSeriesFile> series;
+  if (o.resume) {
+    if (!fs::exists(checkpoint_path))
+      throw Error(fmt::format("resume: no checkpoint in '{}' to resume from", folder.string()));
+    CapsuleCheckpoint saved = CapsuleCheckpoint::read(checkpoint_path, membrane.num_vertices());
+    if (const std::string diff = compare_arguments(o.arguments, saved.arguments); !diff.empty())
+      throw Error(fmt::format("resume: the arguments differ from the run in '{}': {}", folder.string(), diff));
+    if (saved.solver != solver.name())
+      throw Error(fmt::format("{}: \"solver\" is \"{}\", this run uses \"{}\"", checkpoint_path.string(), saved.solver,
+                              solver.name()));
+    solver.restore_state(saved.positions, saved.time, saved.counters, saved.solver_state.fields, folder,
+                         checkpoint_path.string());
+    series.emplace(TimeSeriesFile::resume(series_path, saved.steps));
+    const SteadyWindow window = SteadyWindow::for_run(o.t_end);
+    if (!(saved.steady.window() == window)) {
+      note(fmt::format("t_end moved the steady window from [{}, {}] to [{}, {}]: its sums are recomputed from {}",
+                       saved.steady.window().begin, saved.steady.window().end, window.begin, window.end,
+                       series_path.string()));
+      const std::vector<TimeSeriesRow> rows = read_time_series(series_path);
+      saved.steady = SteadyStatistics(window);
+      for (const TimeSeriesRow& r : rows) saved.steady.add(r);
+    }
+    saved.arguments = o.arguments;
+    state = std::move(saved);
+    note(fmt::format("resuming at gamma t = {:.4g} from {}", solver.time(), checkpoint_path.string()));
+  }
+
+  const auto start = std::chrono::steady_clock::now();
+  auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
+  const double wall_before = state.wall_seconds;
+
+  auto write_checkpoint = [&](const Points& x, double t) {
+    const std::string tag = fmt::format("{:05d}", state.snapshots.size());
+    const std::string name = fmt::format("snapshot_{}.vtp", tag);
+    write_mesh(folder / name, membrane.topology(), x);
+    state.snapshots.emplace_back(t, name);
+    write_pvd(folder / "shapes.pvd", state.snapshots);
+    const std::vector<std::string> old_side_files = state.solver_state.side_files;
+    state.solver_state = solver.save_state(folder, tag);
+    state.time = t;
+    state.positions = x;
+    state.counters = solver.counters();
+    state.wall_seconds = wall_before + elapsed();
+    state.write(checkpoint_path);
+    const std::set<std::string> keep(state.solver_state.side_files.begin(), state.solver_state.side_files.end());
+    for (const std::string& f : old_side_files)
+      if (!keep.count(f)) {
+        std::error_code ec;
+        fs::remove(folder / f, ec);
+      }
+  };
+
+  if (!o.resume) {
+    fs::create_directories(folder);
+    series.emplace(TimeSeriesFile::create(series_path));
+    write_checkpoint(solver.positions(), solver.time());
+  }
+
+  const double t_start = solver.time();
+  double next_snapshot =
+      (state.snapshots.empty() ? state.time : state.snapshots.back().first) + o.snapshot_every;
+  double last_progress = -std::numeric_limits<double>::infinity();
+  std::int64_t steps_here = 0;
+  bool stopped = false;
+  solver.advance(o.t_end, [&](const AcceptedStep& s) {
+    ++state.steps;
+    ++steps_here;
+    const TimeSeriesRow row = capsule_sample(membrane, *s.positions, s.time, s.dt);
+    series->append(row);
+    state.steady.add(row);
+    const bool at_end = s.time >= o.t_end - 1e-12;
+    if (s.time >= next_snapshot - 1e-9 * o.snapshot_every || at_end) {
+      write_checkpoint(*s.positions, s.time);
+      next_snapshot += o.snapshot_every;
+    }
+    const double now = elapsed();
+    if (o.on_progress && (now - last_progress >= o.progress_interval_seconds || at_end)) {
+      last_progress = now;
+      CapsuleProgress p;
+      p.time = s.time;
+      p.t_start = t_start;
+      p.t_end = o.t_end;
+      p.dt = s.dt;
+      p.D = row.D;
+      p.theta = row.theta;
+      p.steps = state.steps;
+      p.elapsed_seconds = now;
+      const double done = (s.time - t_start) / (o.t_end - t_start);
+      p.eta_seconds = done > 0 ? now * (1 - done) / done : 0;
+      p.final = at_end;
+      o.on_progress(p);
+    }
+    if (o.stop_after_steps > 0 && steps_here >= o.stop_after_steps && !at_end) {
+      stopped = true;
+      return false;
+    }
+    return true;
+  });
+  CapsuleRunResult result;
+  if (stopped) return result;
+
+  const SolverCounters counters = solver.counters();
+  nlohmann::json summary = o.arguments;
+  for (const auto& [key, value] : o.summary_fields.items()) summary[key] = value;
+  const SteadyStatistics& st = state.steady;
+  const nlohmann::json fields = {
+      {"format_version", CapsuleCheckpoint::kVersion},
+      {"solver", solver.name()},
+      {"vertices", membrane.num_vertices()},
+      {"triangles", membrane.topology().num_faces()},
+      {"t_end", o.t_end},
+      {"steady_window", {st.window().begin, st.window().end}},
+      {"D_steady", finite_or_null(st.D())},
+      {"theta_steady", finite_or_null(st.theta())},
+      {"mean_gamma_dt", finite_or_null(st.mean_dt())},
+      {"steady_rows", st.count()},
+      {"steps", state.steps},
+      {"rejected_steps", counters.rejected_steps},
+      {"velocity_evaluations", counters.velocity_evaluations},
+      {"final_volume", capsule_shape(membrane.topology(), solver.positions()).volume},
+      {"initial_volume", membrane.reference_volume()},
+      {"wall_seconds", wall_before + elapsed()}};
+  for (const auto& [key, value] : fields.items()) summary[key] = value;
+  AtomicFile f(folder / "summary.json");
+  f.stream() << summary.dump(2) << '\n';
+  f.commit();
+  result.finished = true;
+  result.summary = std::move(summary);
+  return result;
+}
+
+}  // namespace bendlab

@@ -1,0 +1,96 @@
+#include "bendlab/capsule/time_series.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "bendlab/core/atomic_file.hpp"
+
+namespace bendlab {
+
+const char* time_series_header() { return "gamma_t,D,theta,volume,area,E_bend,E_elastic,dt"; }
+
+std::string format_time_series_row(const TimeSeriesRow& r) {
+  return fmt::format("{:.10g},{:.12g},{:.12g},{:.15g},{:.15g},{},{:.12g},{:.6g}\n", r.t, r.D, r.theta, r.volume,
+                     r.area, std::isnan(r.E_bend) ? std::string("nan") : fmt::format("{:.12g}", r.E_bend),
+                     r.E_elastic, r.dt);
+}
+
+namespace {
+std::ifstream open_series(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  if (!in) throw Error(fmt::format("cannot read '{}'", path.string()));
+  std::string header;
+  std::getline(in, header);
+  if (header != time_series_header())
+    throw Error(fmt::format("'{}': header is '{}', expected '{}'", path.string(), header, time_series_header()));
+  return in;
+}
+
+double parse_number(const std::string& s, const std::filesystem::path& path, std::int64_t line) {
+  if (s == "nan") return std::numeric_limits<double>::quiet_NaN();
+  try {
+    std::size_t used = 0;
+    const double v = std::stod(s, &used);
+    if (used == s.size()) return v;
+  } catch (const std::exception&) {
+  }
+  throw Error(fmt::format("'{}' line {}: '{}' is not a number", path.string(), line, s));
+}
+}  // namespace
+
+std::vector<TimeSeriesRow> read_time_series(const std::filesystem::path& path) {
+  std::ifstream in = open_series(path);
+  std::vector<TimeSeriesRow> rows;
+  std::string line;
+  for (std::int64_t n = 2; std::getline(in, line); ++n) {
+    std::vector<double> v;
+    std::istringstream s(line);
+    for (std::string cell; std::getline(s, cell, ',');) v.push_back(parse_number(cell, path, n));
+    if (v.size() != 8) throw Error(fmt::format("'{}' line {}: {} columns, expected 8", path.string(), n, v.size()));
+    rows.push_back({v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7]});
+  }
+  return rows;
+}
+
+TimeSeriesFile::TimeSeriesFile(std::filesystem::path path, std::int64_t rows) : path_(std::move(path)), rows_(rows) {
+  out_.open(path_, std::ios::out | std::ios::app);
+  if (!out_) throw Error(fmt::format("cannot append to '{}'", path_.string()));
+}
+
+TimeSeriesFile TimeSeriesFile::create(const std::filesystem::path& path) {
+  AtomicFile f(path);
+  f.stream() << time_series_header() << '\n';
+  f.commit();
+  return TimeSeriesFile(path, 0);
+}
+
+TimeSeriesFile TimeSeriesFile::resume(const std::filesystem::path& path, std::int64_t rows) {
+  std::ifstream in = open_series(path);
+  AtomicFile f(path);
+  f.stream() << time_series_header() << '\n';
+  std::string line;
+  for (std::int64_t k = 0; k < rows; ++k) {
+    if (!std::getline(in, line) || in.eof())
+      throw Error(fmt::format("'{}' has {} complete rows, the checkpoint needs {}", path.string(), k, rows));
+    f.stream() << line << '\n';
+  }
+  in.close();
+  f.commit();
+  return TimeSeriesFile(path, rows);
+}
+
+TimeSeriesFile TimeSeriesFile::append_to(const std::filesystem::path& path, std::int64_t rows) {
+  return TimeSeriesFile(path, rows);
+}
+
+void TimeSeriesFile::append(const TimeSeriesRow& row) {
+  out_ << format_time_series_row(row);
+  out_.flush();
+  if (!out_) throw Error(fmt::format("error while writing '{}' (row {})", path_.string(), rows_ + 1));
+  ++rows_;
+}
+
+}  // namespace bendlab

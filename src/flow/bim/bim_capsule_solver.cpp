@@ -1,0 +1,107 @@
+#include "bendlab/flow/bim/bim_capsule_solver.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+#include "bendlab/flow/volume_correction.hpp"
+#include "bendlab/geometry/measures.hpp"
+#include "bendlab/integrate/cash_karp.hpp"
+
+namespace bendlab {
+
+namespace {
+const std::shared_ptr<const MembraneModel>& checked(const std::shared_ptr<const MembraneModel>& m,
+                                                    const BimOptions& o) {
+  if (m == nullptr) throw Error("BIM: no membrane model");
+  if (!(o.mu > 0) || !std::isfinite(o.mu)) throw Error(fmt::format("BIM: mu must be positive, got {}", o.mu));
+  if (!(o.gamma > 0) || !std::isfinite(o.gamma))
+    throw Error(fmt::format("BIM: gamma must be positive, got {}", o.gamma));
+  return m;
+}
+
+Points centred(const MembraneModel& m) {
+  Points x = m.reference_positions();
+  x.rowwise() -= volume_centroid(m.topology(), x).transpose();
+  return x;
+}
+}  // namespace
+
+BimCapsuleSolver::BimCapsuleSolver(std::shared_ptr<const MembraneModel> membrane,
+                                   std::unique_ptr<Integrator> integrator, BimOptions options)
+    : membrane_(checked(membrane, options)),
+      integrator_(integrator ? std::move(integrator) : std::make_unique<CashKarp>()),
+      options_(options),
+      single_layer_(membrane_->topology_ptr(), options.quadrature),
+      x_(centred(*membrane_)) {}
+
+void BimCapsuleSolver::restart(const Points& positions, double time, double dt_next) {
+  const int n = membrane_->num_vertices();
+  if (positions.rows() != n) throw Error(fmt::format("BIM restart: {} positions for {} vertices", positions.rows(), n));
+  if (!positions.allFinite()) throw Error("BIM restart: positions are not finite");
+  if (!std::isfinite(time) || time < 0) throw Error(fmt::format("BIM restart: invalid time {}", time));
+  x_ = positions;
+  t_ = time;
+  dt_next_ = dt_next > 0 ? dt_next : 0;
+}
+
+void BimCapsuleSolver::velocity(const Points& x, Points& u) {
+  membrane_->force_density(x, density_);
+  single_layer_.velocity(x, density_, options_.mu, u);
+  u.col(0) += options_.gamma * x.col(2);  // u_inf = gamma z e_x
+  volume_gradient(membrane_->topology(), x, grad_);
+  project_zero_flux(grad_, u);
+  ++counters_.velocity_evaluations;
+}
+
+bool BimCapsuleSolver::advance(double t_end, const OnStep& on_step) {
+  if (!(t_end > t_)) return true;
+  const int n = membrane_->num_vertices();
+  const Topology& topology = membrane_->topology();
+  const double volume0 = membrane_->reference_volume();
+  const std::int64_t rejected_before = counters_.rejected_steps;
+  // The state vector is the row-major N x 3 position array, flattened.
+  Eigen::VectorXd y = Eigen::Map<const Eigen::VectorXd>(x_.data(), 3 * n);
+  auto rhs = [&](double, const Eigen::VectorXd& state, Eigen::VectorXd& dydt) {
+    xb_ = Eigen::Map<const Points>(state.data(), n, 3);
+    velocity(xb_, u_);
+    dydt = Eigen::Map<const Eigen::VectorXd>(u_.data(), 3 * n);
+  };
+  auto on_accept = [&](double t, double dt, Eigen::VectorXd& state) {
+    Eigen::Map<Points> xs(state.data(), n, 3);
+    x_ = xs;
+    rescale_to_volume(topology, x_, volume0);
+    xs = x_;
+    t_ = t;
+    dt_next_ = integrator_->proposed_step();
+    counters_.rejected_steps = rejected_before + integrator_->stats().rejected;
+    if (!on_step) return true;
+    AcceptedStep s;
+    s.time = t;
+    s.dt = dt;
+    s.positions = &x_;
+    return on_step(s);
+  };
+  const IntegratorStats st = integrator_->integrate(rhs, t_, t_end, y, dt_next_, on_accept);
+  counters_.rejected_steps = rejected_before + st.rejected;
+  if (!st.stopped) dt_next_ = st.dt_next;
+  return !st.stopped;
+}
+
+SolverState BimCapsuleSolver::save_state(const std::filesystem::path&, const std::string&) const {
+  SolverState s;
+  s.fields = {{"dt_next", dt_next_}};
+  return s;
+}
+
+void BimCapsuleSolver::restore_state(const Points& positions, double time, const SolverCounters& counters,
+                                     const nlohmann::json& fields, const std::filesystem::path&,
+                                     const std::string& source) {
+  if (!fields.is_object() || !fields.contains("dt_next") || !fields.at("dt_next").is_number() ||
+      !std::isfinite(fields.at("dt_next").get<double>()) || fields.at("dt_next").get<double>() < 0)
+    throw Error(fmt::format("{}: \"solver_state\": \"dt_next\" must be a finite number >= 0", source));
+  restart(positions, time, fields.at("dt_next").get<double>());
+  counters_ = counters;
+}
+
+}  // namespace bendlab

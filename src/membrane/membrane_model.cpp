@@ -1,0 +1,69 @@
+#include "bendlab/membrane/membrane_model.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+#include "bendlab/geometry/measures.hpp"
+#include "bendlab/geometry/mesh_geometry.hpp"
+
+namespace bendlab {
+
+namespace {
+const MembraneParameters& checked(const MembraneParameters& p) {
+  if (!(p.kS > 0) || !std::isfinite(p.kS)) throw Error(fmt::format("membrane: kS must be positive, got {}", p.kS));
+  if (!(p.kB >= 0) || !std::isfinite(p.kB))
+    throw Error(fmt::format("membrane: kB must be non-negative, got {}", p.kB));
+  if (p.kB > 0 && p.bending == nullptr) throw Error("membrane: kB > 0 needs a bending method");
+  return p;
+}
+}  // namespace
+
+MembraneModel::MembraneModel(const TriMesh& reference, MembraneParameters parameters)
+    : topology_(reference.topology_ptr()),
+      reference_(reference.positions()),
+      parameters_(checked(parameters)),
+      elastic_(make_elastic_law(parameters_.elastic_law, topology_, reference_, parameters_.kS)),
+      reference_volume_(enclosed_volume(*topology_, reference_)) {}
+
+void MembraneModel::forces(const Points& x, Points& force) const {
+  if (x.rows() != topology_->num_vertices())
+    throw Error(fmt::format("membrane: {} positions for {} vertices", x.rows(), topology_->num_vertices()));
+  elastic_->forces(x, force);
+  if (parameters_.bending != nullptr && parameters_.kB > 0) {
+    Points bending;
+    parameters_.bending->forces(*topology_, x, parameters_.kB, bending);
+    force += bending;
+  }
+  if (parameters_.volume_force != nullptr)
+    parameters_.volume_force->add_forces(*topology_, x, reference_volume_, force);
+}
+
+MembraneForces MembraneModel::evaluate(const Points& x) const {
+  MembraneForces r;
+  forces(x, r.force);
+  r.mixed_area = MeshGeometry::compute(*topology_, x).mixed_area;
+  r.density = r.force.array().colwise() / r.mixed_area.array();  // eq. (14)
+  return r;
+}
+
+void MembraneModel::force_density(const Points& x, Points& density) const {
+  Points force;
+  forces(x, force);
+  const MeshGeometry geometry = MeshGeometry::compute(*topology_, x);
+  density = force.array().colwise() / geometry.mixed_area.array();  // eq. (14)
+}
+
+double MembraneModel::elastic_energy(const Points& x) const { return elastic_->energy(x); }
+
+std::optional<double> MembraneModel::bending_energy(const Points& x) const {
+  if (parameters_.bending == nullptr) return std::nullopt;
+  return parameters_.bending->energy(*topology_, x, parameters_.kB);
+}
+
+std::optional<double> MembraneModel::volume_energy(const Points& x) const {
+  if (parameters_.volume_force == nullptr) return std::nullopt;
+  return parameters_.volume_force->energy(*topology_, x, reference_volume_);
+}
+
+}  // namespace bendlab

@@ -1,0 +1,295 @@
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "bendlab/capsule/capsule_run.hpp"
+#include "bendlab/capsule/checkpoint.hpp"
+#include "bendlab/capsule/shear_units.hpp"
+#include "bendlab/capsule/steady_statistics.hpp"
+#include "bendlab/flow/bim/bim_capsule_solver.hpp"
+#include "bendlab/mesh/generators.hpp"
+
+using namespace bendlab;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+void spit(const fs::path& p, const std::string& text) { std::ofstream(p) << text; }
+
+class CapsuleRun : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir = fs::temp_directory_path() /
+          ("bendlab_capsule_" + std::to_string(::getpid()) + "_" +
+           ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+  }
+  void TearDown() override { fs::remove_all(dir); }
+
+  // 320 triangles, G = 0.1, no bending: the CLI's smallest shear run.
+  static std::shared_ptr<const MembraneModel> membrane(int level = 2) {
+    MembraneParameters p;
+    p.kS = ShearUnits::from(0.1, 0.0, std::nullopt).kS();
+    return std::make_shared<const MembraneModel>(sphere_mesh(MeshFamily::MT1, level), p);
+  }
+  static std::unique_ptr<BimCapsuleSolver> solver(int level = 2) {
+    return std::make_unique<BimCapsuleSolver>(membrane(level));
+  }
+  CapsuleRunOptions options(const fs::path& folder, double t_end = 0.3) const {
+    CapsuleRunOptions o;
+    o.folder = folder;
+    o.t_end = t_end;
+    o.snapshot_every = 0.1;
+    o.arguments = {{"solver", "bim"}, {"G", 0.1}, {"kappa_b_hat", 0.0}};
+    return o;
+  }
+  static nlohmann::json without_wall_time(nlohmann::json j) {
+    j.erase("wall_seconds");
+    return j;
+  }
+
+  fs::path dir;
+};
+
+}  // namespace
+
+TEST(SteadyStatistics, WindowAndWeightedMeans) {
+  EXPECT_EQ(SteadyWindow::for_run(10), (SteadyWindow{5, 10}));
+  EXPECT_EQ(SteadyWindow::for_run(25), (SteadyWindow{5, 10}));
+  EXPECT_EQ(SteadyWindow::for_run(4), (SteadyWindow{2, 4}));
+  SteadyStatistics s(SteadyWindow::for_run(4));
+  EXPECT_TRUE(std::isnan(s.D()));
+  EXPECT_TRUE(std::isnan(s.mean_dt()));
+  // Rows before the window are left out; each row in it is weighted by its step.
+  s.add({1.0, 9.0, 9.0, 0, 0, 0, 0, 0.5});
+  s.add({2.5, 0.2, 0.1, 0, 0, 0, 0, 0.5});
+  s.add({3.0, 0.4, 0.4, 0, 0, 0, 0, 0.5});
+  s.add({4.0, 0.1, 0.7, 0, 0, 0, 0, 1.0});
+  s.add({4.0 + 1e-13, 0.1, 0.7, 0, 0, 0, 0, 1e-13});  // round-off past the end still counts
+  EXPECT_EQ(s.count(), 4);
+  const double w = 0.5 + 0.5 + 1.0 + 1e-13;
+  EXPECT_NEAR(s.D(), (0.2 * 0.5 + 0.4 * 0.5 + 0.1 * 1.0 + 0.1 * 1e-13) / w, 1e-15);
+  EXPECT_NEAR(s.theta(), (0.1 * 0.5 + 0.4 * 0.5 + 0.7 * 1.0 + 0.7 * 1e-13) / w, 1e-15);
+  EXPECT_NEAR(s.mean_dt(), w / 4, 1e-15);
+  // The running sums survive JSON text exactly.
+  const SteadyStatistics back =
+      SteadyStatistics::from_json(nlohmann::json::parse(s.to_json().dump()), "test");
+  EXPECT_EQ(back.D(), s.D());
+  EXPECT_EQ(back.theta(), s.theta());
+  EXPECT_EQ(back.mean_dt(), s.mean_dt());
+  EXPECT_EQ(back.window(), s.window());
+  nlohmann::json bad = s.to_json();
+  bad["count"] = -1;
+  EXPECT_THROW(SteadyStatistics::from_json(bad, "test"), Error);
+  bad = s.to_json();
+  bad.erase("D_dt");
+  try {
+    SteadyStatistics::from_json(bad, "file.json");
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("D_dt"), std::string::npos) << e.what();
+  }
+}
+
+TEST_F(CapsuleRun, TimeSeriesResumeKeepsRowsByteForByte) {
+  const fs::path p = dir / "timeseries.csv";
+  {
+    TimeSeriesFile f = TimeSeriesFile::create(p);
+    for (int k = 1; k <= 5; ++k) f.append({0.1 * k, 0.01 * k, 0.2, 4.18, 12.5, NAN, 1e-3 * k, 0.1});
+    EXPECT_EQ(f.rows(), 5);
+  }
+  const std::string full = slurp(p);
+  const auto rows = read_time_series(p);
+  ASSERT_EQ(rows.size(), 5u);
+  EXPECT_TRUE(std::isnan(rows[2].E_bend));
+  EXPECT_EQ(rows[4].D, 0.05);
+  spit(p, full + "0.6,0.0");  // a torn last row, as a killed run may leave
+  {
+    TimeSeriesFile f = TimeSeriesFile::resume(p, 3);
+    f.append(rows[3]);
+    f.append(rows[4]);
+  }
+  EXPECT_EQ(slurp(p), full);
+  // The rewrite is atomic: no temporary file is left beside it.
+  for (const auto& e : fs::directory_iterator(dir)) EXPECT_EQ(e.path().filename(), "timeseries.csv");
+  EXPECT_THROW(TimeSeriesFile::resume(p, 6), Error);  // fewer rows than the checkpoint needs
+  EXPECT_EQ(slurp(p), full);                          // and the file is untouched
+  spit(dir / "other.csv", "t,D\n");
+  EXPECT_THROW(TimeSeriesFile::resume(dir / "other.csv", 0), Error);
+}
+
+TEST_F(CapsuleRun, FailedRowWriteIsAnError) {
+  if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
+  TimeSeriesFile f = TimeSeriesFile::append_to("/dev/full");
+  try {
+    f.append({0.1, 0, 0, 0, 0, 0, 0, 0.1});
+    FAIL() << "writing to /dev/full succeeded";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("/dev/full"), std::string::npos) << e.what();
+  }
+}
+
+TEST_F(CapsuleRun, ResumedRunEqualsUninterruptedRun) {
+  const fs::path full = dir / "full", parts = dir / "parts";
+  auto s1 = solver();
+  const CapsuleRunResult r1 = run_capsule(*s1, options(full));
+  ASSERT_TRUE(r1.finished);
+  const std::int64_t steps = r1.summary.at("steps");
+  ASSERT_GT(steps, 6);
+  // Interrupt after most of the steps (past at least one snapshot), then resume in a fresh solver.
+  CapsuleRunOptions o = options(parts);
+  o.stop_after_steps = steps - 3;
+  auto s2 = solver();
+  EXPECT_FALSE(run_capsule(*s2, o).finished);
+  EXPECT_FALSE(fs::exists(parts / "summary.json"));
+  s2.reset();
+  o.stop_after_steps = 0;
+  o.resume = true;
+  std::vector<std::string> notes;
+  o.on_note = [&](const std::string& s) { notes.push_back(s); };
+  auto s3 = solver();
+  const CapsuleRunResult r3 = run_capsule(*s3, o);
+  ASSERT_TRUE(r3.finished);
+  ASSERT_FALSE(notes.empty());
+  EXPECT_NE(notes.back().find("resuming"), std::string::npos);
+  EXPECT_EQ(slurp(parts / "timeseries.csv"), slurp(full / "timeseries.csv"));
+  EXPECT_EQ(without_wall_time(r3.summary), without_wall_time(r1.summary));
+  EXPECT_EQ(without_wall_time(nlohmann::json::parse(slurp(parts / "summary.json"))),
+            without_wall_time(nlohmann::json::parse(slurp(full / "summary.json"))));
+  EXPECT_EQ(slurp(parts / "shapes.pvd"), slurp(full / "shapes.pvd"));
+  EXPECT_EQ(s3->positions(), s1->positions());
+
+  // Extending the run moves the steady window: the sums are rebuilt from the file (D and theta with
+  // 12 digits, dt with 6), and the new rows are added at full precision.
+  o.t_end = 0.4;
+  notes.clear();
+  auto s5 = solver();
+  const CapsuleRunResult r5 = run_capsule(*s5, o);
+  ASSERT_TRUE(r5.finished);
+  EXPECT_NE(notes.front().find("steady window"), std::string::npos);
+  SteadyStatistics check(SteadyWindow::for_run(0.4));
+  for (const TimeSeriesRow& row : read_time_series(parts / "timeseries.csv")) check.add(row);
+  EXPECT_NEAR(r5.summary.at("D_steady").get<double>(), check.D(), 1e-6 * check.D());
+  EXPECT_NEAR(r5.summary.at("theta_steady").get<double>(), check.theta(), 1e-6 * check.theta());
+  EXPECT_EQ(r5.summary.at("steady_rows").get<std::int64_t>(), check.count());
+  EXPECT_EQ(r5.summary.at("steady_window"), nlohmann::json({0.2, 0.4}));
+}
+
+TEST_F(CapsuleRun, CheckpointIsValidatedAsAWhole) {
+  auto s = solver();
+  CapsuleRunOptions o = options(dir / "run", 0.15);
+  ASSERT_TRUE(run_capsule(*s, o).finished);
+  const fs::path cp = dir / "run" / "checkpoint.json";
+  const std::string good = slurp(cp);
+  const int n = s->membrane().num_vertices();
+  auto refused = [&](const std::string& text, const std::string& expected) {
+    spit(cp, text);
+    auto fresh = solver();
+    CapsuleRunOptions r = o;
+    r.resume = true;
+    try {
+      run_capsule(*fresh, r);
+      ADD_FAILURE() << "accepted a checkpoint that should name " << expected;
+    } catch (const Error& e) {
+      const std::string msg = e.what();
+      EXPECT_NE(msg.find(expected), std::string::npos) << msg;
+      EXPECT_NE(msg.find("checkpoint"), std::string::npos) << msg;
+    }
+  };
+  refused("", "empty");
+  refused("{\"version\": 2, \"time\": ", "not valid JSON");
+  refused("[1, 2]", "object");
+  auto edited = [&](auto edit) {
+    nlohmann::json j = nlohmann::json::parse(good);
+    edit(j);
+    return j.dump();
+  };
+  refused(edited([](auto& j) { j.erase("version"); j["arguments"] = {{"kappa_b", 0.1}}; }), "older bendlab");
+  refused(edited([](auto& j) { j["version"] = 7; }), "\"version\"");
+  refused(edited([](auto& j) { j.erase("positions"); }), "\"positions\" is missing");
+  refused(edited([](auto& j) { j["positions"].erase(0); }), "\"positions\"");
+  refused(edited([](auto& j) { j["positions"][4] = "x"; }), "entry 4");
+  refused(edited([](auto& j) { j["vertices"] = 12; }), "\"vertices\"");
+  refused(edited([](auto& j) { j["time"] = -1; }), "\"time\"");
+  refused(edited([](auto& j) { j["steps"] = 1.5; }), "\"steps\"");
+  refused(edited([](auto& j) { j["steps"] = 100000; }), "timeseries.csv");
+  refused(edited([](auto& j) { j["counters"] = {{"rejected_steps", 0}}; }), "velocity_evaluations");
+  refused(edited([](auto& j) { j["steady"]["count"] = "x"; }), "count");
+  refused(edited([](auto& j) { j["snapshots"] = {{0.0, "../evil.vtp"}}; }), "snapshots");
+  refused(edited([](auto& j) { j["snapshots"] = {{1e9, "snapshot_00000.vtp"}}; }), "snapshots");
+  refused(edited([](auto& j) { j["solver_state"]["dt_next"] = nullptr; }), "dt_next");
+  refused(edited([](auto& j) { j["solver"] = "lbm"; }), "solver");
+  {
+    spit(cp, edited([](auto& j) { j["arguments"]["G"] = 0.2; }));
+    auto fresh = solver();
+    CapsuleRunOptions r = o;
+    r.resume = true;
+    try {
+      run_capsule(*fresh, r);
+      ADD_FAILURE() << "resumed a run with another G";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("G is 0.1 here but 0.2"), std::string::npos) << e.what();
+    }
+  }
+  // An empty snapshot list is valid (nothing to continue counting from) and does not crash.
+  spit(cp, edited([](auto& j) { j["snapshots"] = nlohmann::json::array(); }));
+  auto fresh = solver();
+  CapsuleRunOptions r = o;
+  r.resume = true;
+  r.t_end = 0.2;
+  EXPECT_TRUE(run_capsule(*fresh, r).finished);
+  EXPECT_EQ(n, fresh->membrane().num_vertices());
+}
+
+TEST_F(CapsuleRun, FailedSnapshotWriteEndsTheRunAndKeepsTheCheckpoint) {
+  // snapshot_00002.vtp cannot be written (a folder is in the way), as on a full or read-only disk.
+  const fs::path run = dir / "run";
+  fs::create_directories(run / "snapshot_00002.vtp" / "blocked");
+  auto s = solver();
+  try {
+    run_capsule(*s, options(run));
+    FAIL() << "the run succeeded";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("snapshot_00002.vtp"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(run / "summary.json"));
+  // The checkpoint of the snapshot before is whole and valid.
+  const CapsuleCheckpoint c = CapsuleCheckpoint::read(run / "checkpoint.json", s->membrane().num_vertices());
+  ASSERT_EQ(c.snapshots.size(), 2u);
+  EXPECT_NEAR(c.time, 0.1, 0.05);
+  EXPECT_GT(static_cast<std::int64_t>(read_time_series(run / "timeseries.csv").size()), c.steps);
+  // After clearing the obstacle the run resumes and finishes.
+  fs::remove_all(run / "snapshot_00002.vtp");
+  auto again = solver();
+  CapsuleRunOptions o = options(run);
+  o.resume = true;
+  EXPECT_TRUE(run_capsule(*again, o).finished);
+}
+
+TEST_F(CapsuleRun, ManyRunsInOneProcess) {
+  // Creating and destroying runs, solvers, membranes and meshes over and over is safe (run this
+  // under the sanitizers: cmake --preset debug). 80 triangles and two steps each keep it fast there.
+  for (int k = 0; k < 50; ++k) {
+    auto s = solver(1);
+    CapsuleRunOptions o = options(dir / ("run" + std::to_string(k % 3)), 0.002);
+    o.snapshot_every = 0.001;
+    int progress = 0;
+    o.on_progress = [&](const CapsuleProgress&) { ++progress; };
+    const CapsuleRunResult r = run_capsule(*s, o);
+    ASSERT_TRUE(r.finished);
+    EXPECT_GE(progress, 1);
+    EXPECT_GT(r.summary.at("steps").get<int>(), 0);
+  }
+}
