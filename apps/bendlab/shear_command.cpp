@@ -1,6 +1,6 @@
 // bendlab shear: an initially spherical capsule (neo-Hookean membrane + bending) in linear shear
-// flow, boundary integral method (paper section 4). Argument parsing only: the membrane is a
-// MembraneModel, the flow a BimCapsuleSolver, and the run folder (timeseries.csv, snapshots,
+// flow, boundary integral method (paper section 4). Argument parsing only: the run is
+// run_shear (bendlab/flow/shear_run.hpp), whose folder (timeseries.csv, snapshots,
 // checkpoint.json, summary.json) belongs to run_capsule (bendlab/capsule/capsule_run.hpp).
 // D_theta.png is drawn by scripts/plot_shear.py, found at run time.
 #include <fmt/format.h>
@@ -8,16 +8,9 @@
 #include <filesystem>
 #include <iostream>
 #include <optional>
-#include <regex>
 
-#include "bendlab/bending/bending_method.hpp"
-#include "bendlab/capsule/capsule_run.hpp"
 #include "bendlab/core/helper_program.hpp"
-#include "bendlab/capsule/shear_units.hpp"
-#include "bendlab/flow/bim/bim_capsule_solver.hpp"
-#include "bendlab/integrate/cash_karp.hpp"
-#include "bendlab/mesh/generators.hpp"
-#include "bendlab/mesh/mesh_io.hpp"
+#include "bendlab/flow/shear_run.hpp"
 #include "cli_common.hpp"
 #include "method_cli.hpp"
 #include "command.hpp"
@@ -36,25 +29,6 @@ struct ShearArgs {
   bool resume = false, plot = true;
 };
 
-/// "mt1:N", "mt2:N" (N triangles of the homogeneous family), "inh:mt1", "inh:mt2" (320 triangles
-/// and three Rivara passes, as in the paper), or a mesh file.
-TriMesh capsule_mesh(const std::string& spec) {
-  std::smatch m;
-  if (std::regex_match(spec, m, std::regex(R"((mt1|mt2|octa):(\d+))"))) {
-    const MeshFamily family = parse_mesh_family(m[1]);
-    const long triangles = std::stol(m[2]);
-    const int level = level_with_triangles(family, triangles);
-    if (level < 0 || level > 7)
-      throw Error(fmt::format("--mesh {}: {} has no level with {} triangles (up to 7 steps of 4x refinement)", spec,
-                              m[1].str(), triangles));
-    return sphere_mesh(family, level);
-  }
-  if (std::regex_match(spec, m, std::regex(R"(inh:(mt1|mt2))"))) return sphere_mesh(parse_mesh_family(m[1]), 2, 3);
-  if (!fs::exists(spec))
-    throw Error(fmt::format("--mesh '{}' is neither mt1:N, mt2:N, inh:mt1, inh:mt2 nor an existing file", spec));
-  return read_mesh(spec);
-}
-
 /// D_theta.png from scripts/plot_shear.py (--plot-script, else found at run time: an install's
 /// share/bendlab/scripts, or scripts/ above the executable), started with an argument vector.
 void plot(const ShearArgs& a) {
@@ -69,63 +43,33 @@ void plot(const ShearArgs& a) {
     note("warning: the plot was not made (needs /usr/bin/python3 with matplotlib)");
 }
 
-void run_shear(const ShearArgs& a) {
-  // Everything is checked before any work starts.
-  require_positive("--G", a.G);
-  if (a.kappa_b_hat) require_positive("--kappa-b-hat", *a.kappa_b_hat, true);
-  if (a.kappa_b) require_positive("--kappa-b", *a.kappa_b, true);
-  require_positive("--t-end", a.t_end);
-  require_positive("--snapshot-every", a.snapshot_every);
-  require_positive("--rtol", a.rtol);
-  require_positive("--atol", a.atol);
-  const ShearUnits units = ShearUnits::from(a.G, a.kappa_b_hat, a.kappa_b);
-  if (a.method == "none" && units.kappa_b_hat > 0)
-    throw Error("--kappa-b-hat or --kappa-b > 0 needs a bending --method (" + method_names_joined() + ")");
-  std::shared_ptr<const BendingMethod> bending;
-  if (a.method != "none") {
-    MethodOptions options;
-    if (a.rings != 0) options["rings"] = std::to_string(a.rings);
-    bending = make_bending_method(a.method, options);
-  }
-  if (fs::exists(a.out) && !fs::is_directory(a.out)) throw Error(fmt::format("--out '{}' is a file, not a folder", a.out));
-  if (a.resume && !fs::exists(fs::path(a.out) / "checkpoint.json"))
-    throw Error(fmt::format("--resume: no checkpoint in '{}' to resume from", a.out));
-  const TriMesh mesh = capsule_mesh(a.mesh);
-
-  MembraneParameters mp;
-  mp.kS = units.kS();
-  mp.kB = units.kB();
-  mp.bending = bending;
-  auto membrane = std::make_shared<const MembraneModel>(mesh, mp);
-  CashKarpOptions ck;
-  ck.rtol = a.rtol;
-  ck.atol = a.atol;
-  BimOptions bim;
-  bim.mu = ShearUnits::mu;
-  bim.gamma = ShearUnits::gamma;
-  BimCapsuleSolver solver(membrane, std::make_unique<CashKarp>(ck), bim);
-
-  CapsuleRunOptions o;
-  o.folder = a.out;
-  o.t_end = a.t_end;
-  o.snapshot_every = a.snapshot_every;
-  o.resume = a.resume;
-  o.stop_after_steps = a.stop_after_steps;
-  o.arguments = {{"solver", a.solver}, {"method", a.method},  {"rings", a.rings},
-                 {"mesh", a.mesh},     {"G", units.G},        {"kappa_b_hat", units.kappa_b_hat},
-                 {"kappa_b", units.kappa_b()}};
-  o.summary_fields = {{"rtol", a.rtol}, {"atol", a.atol}};
-  o.on_note = note;
-  o.on_progress = [](const CapsuleProgress& p) {
+void shear(const ShearArgs& a) {
+  ShearRunSpec spec;
+  spec.folder = a.out;
+  spec.solver = a.solver;
+  spec.method = a.method;
+  if (a.rings != 0) spec.method_options["rings"] = std::to_string(a.rings);
+  spec.mesh = a.mesh;
+  spec.G = a.G;
+  spec.kappa_b_hat = a.kappa_b_hat;
+  spec.kappa_b = a.kappa_b;
+  spec.t_end = a.t_end;
+  spec.snapshot_every = a.snapshot_every;
+  spec.rtol = a.rtol;
+  spec.atol = a.atol;
+  spec.resume = a.resume;
+  spec.stop_after_steps = a.stop_after_steps;
+  ShearRunCallbacks callbacks;
+  callbacks.on_note = note;
+  callbacks.on_progress = [](const CapsuleProgress& p) {
     note(fmt::format("gamma t = {:7.4f} / {:g} ({:3.0f}%)  steps {:6d}  gamma dt {:.2e}  D {:.5f}  theta {:.4f}  "
                      "elapsed {:.0f} s  ETA {:.0f} s",
                      p.time, p.t_end, 100 * (p.time - p.t_start) / (p.t_end - p.t_start), p.steps, p.dt, p.D,
                      p.theta, p.elapsed_seconds, p.eta_seconds));
   };
-  const CapsuleRunResult result = run_capsule(solver, o);
+  const CapsuleRunResult result = run_shear(spec, callbacks);
   if (!result.finished) {
-    note(fmt::format("stopped after {} steps at gamma t = {:.6g}; continue with --resume", a.stop_after_steps,
-                     solver.time()));
+    note(fmt::format("stopped after {} steps; continue with --resume", a.stop_after_steps));
     return;
   }
   std::cout << result.summary.dump() << std::endl;
@@ -164,7 +108,7 @@ const CommandRegistration registration([](CLI::App& app) {
   cmd->add_option("--plot-script", args->plot_script,
                   "plot_shear.py to draw D_theta.png with (default: found beside the executable)");
   cmd->add_option("--out", args->out, "output folder (created if missing)")->required();
-  cmd->callback([args] { run_shear(*args); });
+  cmd->callback([args] { shear(*args); });
 });
 
 }  // namespace

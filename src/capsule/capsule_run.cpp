@@ -178,6 +178,10 @@ CapsuleRunResult run_capsule(CapsuleSolver& solver, const CapsuleRunOptions& o) 
       stopped = true;
       return false;
     }
+    if (o.should_stop && !at_end && o.should_stop()) {
+      stopped = true;
+      return false;
+    }
     return true;
   });
   CapsuleRunResult result;

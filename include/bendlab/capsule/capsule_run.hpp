@@ -50,6 +50,9 @@ struct CapsuleRunOptions {
   /// Stop (without a summary) after this many accepted steps of this part; 0: never. The run can
   /// then be resumed from its last checkpoint (how tests interrupt a run).
   std::int64_t stop_after_steps = 0;
+  /// Asked after every accepted step; true stops the run as stop_after_steps does (no summary;
+  /// resumable from the last checkpoint). How an interactive caller (Ctrl-C in Python) stops.
+  std::function<bool()> should_stop;
   double progress_interval_seconds = 2;  ///< wall time between progress reports
   std::function<void(const CapsuleProgress&)> on_progress;
   std::function<void(const std::string&)> on_note;

@@ -1,0 +1,46 @@
+#pragma once
+// The paper's section 4 run, as one library call: an initially spherical capsule (elastic law +
+// bending method) in the shear flow u = gamma z e_x, in the units of capsule/shear_units.hpp
+// (R = mu = gamma = 1, kS = 1/G, kB = kappa_b_hat / G), solved by a flow solver behind
+// CapsuleSolver and kept by run_capsule (capsule/capsule_run.hpp: time series, snapshots,
+// checkpoint, summary). `bendlab shear` and the Python module both call it, so a run started by
+// one can be resumed by the other.
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <string>
+
+#include "bendlab/bending/bending_method.hpp"
+#include "bendlab/capsule/capsule_run.hpp"
+
+namespace bendlab {
+
+struct ShearRunSpec {
+  std::filesystem::path folder;        ///< run folder (created if missing)
+  std::string solver = "bim";          ///< flow solver: "bim"
+  std::string method = "none";         ///< bending method (registry name) or "none"
+  MethodOptions method_options;        ///< options of the method, as on a command line
+  std::string mesh = "mt1:1280";       ///< mesh_spec.hpp: mt1:N, mt2:N, octa:N, inh:mt1, inh:mt2 or a file
+  double G = 0.1;                      ///< mu gamma R / kS
+  std::optional<double> kappa_b_hat;   ///< kB / (R^2 kS) (exclusive with kappa_b)
+  std::optional<double> kappa_b;       ///< dimensional kB
+  double t_end = 10;                   ///< gamma t
+  double snapshot_every = 0.5;         ///< gamma t between snapshots and checkpoints
+  double rtol = 1e-7, atol = 1e-6;     ///< the adaptive integrator's tolerances (atol in units of R)
+  bool resume = false;                 ///< continue from folder/checkpoint.json
+  std::int64_t stop_after_steps = 0;   ///< stop (resumable) after this many steps; 0: never
+};
+
+struct ShearRunCallbacks {
+  std::function<void(const CapsuleProgress&)> on_progress;
+  std::function<void(const std::string&)> on_note;
+  std::function<bool()> should_stop;  ///< true stops the run (resumable from its last checkpoint)
+  double progress_interval_seconds = 2;
+};
+
+/// Checks every parameter (before any file is touched), builds the mesh, the membrane model and
+/// the solver, and runs. Throws bendlab::Error with a one-line message naming the option.
+CapsuleRunResult run_shear(const ShearRunSpec& spec, const ShearRunCallbacks& callbacks = {});
+
+}  // namespace bendlab

@@ -1,0 +1,17 @@
+#pragma once
+// Meshes named by a short specification, as the capsule runs take them:
+//   "mt1:N", "mt2:N", "octa:N"   the unit-sphere mesh of that family with N triangles
+//                                (320, 1280, 5120, ... for MT1/MT2; 512, 2048, ... for octa)
+//   "inh:mt1", "inh:mt2"         320 triangles and three Rivara passes (the paper's inhomogeneous meshes)
+//   anything else                a mesh file (.off, .obj, .ply), read and validated
+#include <string>
+
+#include "bendlab/mesh/trimesh.hpp"
+
+namespace bendlab {
+
+/// The mesh of `spec` (see above). Throws bendlab::Error naming the spec for a family without
+/// that many triangles, or a file that is missing or refused.
+TriMesh mesh_from_spec(const std::string& spec);
+
+}  // namespace bendlab
