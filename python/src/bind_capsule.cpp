@@ -1,0 +1,128 @@
+// The capsule in shear flow (paper section 4): start or resume a run, read its time series and
+// summary. The run is the library's run_shear, so a run started from Python resumes from the
+// command line and the other way round.
+#include <pybind11/functional.h>
+#include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
+
+#include <optional>
+
+#include "arrays.hpp"
+#include "bendlab/capsule/time_series.hpp"
+#include "bendlab/core/file_input.hpp"
+#include "bendlab/flow/shear_run.hpp"
+#include "bindings.hpp"
+
+namespace bendlab::python {
+
+namespace {
+
+py::object json_to_python(const nlohmann::json& j) { return py::module_::import("json").attr("loads")(j.dump()); }
+
+std::string option_value(const py::handle& v) {
+  if (py::isinstance<py::bool_>(v)) return v.cast<bool>() ? "true" : "false";
+  return py::str(v);
+}
+
+}  // namespace
+
+void bind_capsule(py::module_& m) {
+  m.def(
+      "shear_run",
+      [](const std::filesystem::path& folder, const std::string& method, const std::string& mesh, double G,
+         std::optional<double> kappa_b_hat, std::optional<double> kappa_b, double t_end, double snapshot_every,
+         double rtol, double atol, bool resume, std::int64_t stop_after_steps, const py::object& progress,
+         double progress_interval, const py::dict& method_options) -> py::object {
+        ShearRunSpec spec;
+        spec.folder = folder;
+        spec.method = method;
+        for (auto [k, v] : method_options) spec.method_options[py::str(k)] = option_value(v);
+        spec.mesh = mesh;
+        spec.G = G;
+        spec.kappa_b_hat = kappa_b_hat;
+        spec.kappa_b = kappa_b;
+        spec.t_end = t_end;
+        spec.snapshot_every = snapshot_every;
+        spec.rtol = rtol;
+        spec.atol = atol;
+        spec.resume = resume;
+        spec.stop_after_steps = stop_after_steps;
+
+        // Python errors raised in a callback, or Ctrl-C, stop the run at the next accepted step
+        // (resumable from its last checkpoint) and are raised again here.
+        std::optional<py::error_already_set> pending;
+        ShearRunCallbacks cb;
+        cb.progress_interval_seconds = progress_interval;
+        cb.should_stop = [&pending]() {
+          py::gil_scoped_acquire gil;
+          if (!pending && PyErr_CheckSignals() != 0) pending.emplace();
+          return pending.has_value();
+        };
+        if (!progress.is_none()) {
+          cb.on_progress = [&pending, &progress](const CapsuleProgress& p) {
+            py::gil_scoped_acquire gil;
+            if (pending) return;
+            try {
+              progress(py::dict(py::arg("time") = p.time, py::arg("t_end") = p.t_end, py::arg("dt") = p.dt,
+                                py::arg("D") = p.D, py::arg("theta") = p.theta, py::arg("steps") = p.steps,
+                                py::arg("elapsed_seconds") = p.elapsed_seconds, py::arg("eta_seconds") = p.eta_seconds,
+                                py::arg("final") = p.final));
+            } catch (py::error_already_set& e) {
+              pending.emplace(std::move(e));
+            }
+          };
+        }
+        CapsuleRunResult result;
+        {
+          py::gil_scoped_release release;
+          result = run_shear(spec, cb);
+        }
+        if (pending) throw std::move(*pending);
+        if (!result.finished) return py::none();
+        return json_to_python(result.summary);
+      },
+      py::arg("folder"), py::arg("method") = "none", py::arg("mesh") = "mt1:1280", py::arg("G") = 0.1,
+      py::arg("kappa_b_hat") = py::none(), py::arg("kappa_b") = py::none(), py::arg("t_end") = 10.0,
+      py::arg("snapshot_every") = 0.5, py::arg("rtol") = 1e-7, py::arg("atol") = 1e-6, py::arg("resume") = false,
+      py::arg("stop_after_steps") = 0, py::arg("progress") = py::none(), py::arg("progress_interval") = 2.0,
+      py::arg("method_options") = py::dict(),
+      "Runs an initially spherical capsule (neo-Hookean membrane, eqs. 18-21, plus the bending method) in "
+      "the shear flow u = gamma z e_x with the boundary integral method (eqs. 22-23), units R = mu = gamma "
+      "= 1 (kS = 1/G, kB = kappa_b_hat / G), until gamma t = t_end, keeping the run folder (timeseries.csv, "
+      "snapshots, checkpoint.json, summary.json) exactly as `bendlab shear` does. progress(dict) is called "
+      "every progress_interval seconds. Returns summary.json's content, or None when stopped by "
+      "stop_after_steps. Ctrl-C (or an exception in progress) stops the run at the next step and is raised; "
+      "the folder can then be resumed with resume=True.");
+
+  m.def(
+      "read_time_series",
+      [](const std::filesystem::path& folder) {
+        const std::vector<TimeSeriesRow> rows = read_time_series(folder / "timeseries.csv");
+        const auto n = static_cast<Eigen::Index>(rows.size());
+        Scalars cols[8];
+        for (Scalars& c : cols) c.resize(n);
+        for (Eigen::Index i = 0; i < n; ++i) {
+          const TimeSeriesRow& r = rows[static_cast<std::size_t>(i)];
+          const double v[8] = {r.t, r.D, r.theta, r.volume, r.area, r.E_bend, r.E_elastic, r.dt};
+          for (int k = 0; k < 8; ++k) cols[k][i] = v[k];
+        }
+        py::dict d;
+        const char* names[8] = {"gamma_t", "D", "theta", "volume", "area", "E_bend", "E_elastic", "dt"};
+        for (int k = 0; k < 8; ++k) d[names[k]] = take(std::move(cols[k]));
+        return d;
+      },
+      py::arg("folder"), "The run's timeseries.csv as a dict of numpy arrays (gamma_t, D, theta, ...).");
+
+  m.def(
+      "read_summary",
+      [](const std::filesystem::path& folder) {
+        const std::filesystem::path p = folder / "summary.json";
+        const std::string text = read_regular_file(p, "summary");
+        nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
+        if (j.is_discarded()) throw Error("cannot read summary '" + p.string() + "': not valid JSON");
+        return json_to_python(j);
+      },
+      py::arg("folder"), "The run's summary.json (D_steady, theta_steady, mean_gamma_dt, counters, ...).");
+}
+
+}  // namespace bendlab::python

@@ -1,0 +1,71 @@
+"""Capsule runs from Python: the same run folder as the command line, resumable both ways."""
+import filecmp
+import os
+import signal
+
+import numpy as np
+import pytest
+
+import bendlab
+
+COMMON = dict(method="C", mesh="mt1:320", G=0.1, kappa_b_hat=0.05, t_end=0.3, snapshot_every=0.1)
+
+
+def without_wall(summary):
+    return {k: v for k, v in summary.items() if k != "wall_seconds"}
+
+
+def test_a_python_run_equals_the_cli_run(tmp_path, cli):
+    summary = bendlab.shear_run(tmp_path / "py", **COMMON)
+    cli("shear", "--method", "C", "--mesh", "mt1:320", "--G", "0.1", "--kappa-b-hat", "0.05", "--t-end", "0.3",
+        "--snapshot-every", "0.1", "--no-plot", "--out", tmp_path / "cli")
+    assert filecmp.cmp(tmp_path / "py" / "timeseries.csv", tmp_path / "cli" / "timeseries.csv", shallow=False)
+    assert without_wall(summary) == without_wall(bendlab.read_summary(tmp_path / "cli"))
+    ts = bendlab.read_time_series(tmp_path / "py")
+    assert ts["gamma_t"][-1] == pytest.approx(0.3, abs=1e-12)
+    assert np.all(np.diff(ts["gamma_t"]) > 0) and np.all(ts["D"] >= 0)
+    assert summary["steps"] == len(ts["D"])
+
+
+def test_stop_and_resume_equals_an_uninterrupted_run(tmp_path):
+    full = bendlab.shear_run(tmp_path / "full", **COMMON)
+    assert bendlab.shear_run(tmp_path / "parts", stop_after_steps=5, **COMMON) is None
+    resumed = bendlab.shear_run(tmp_path / "parts", resume=True, **COMMON)
+    assert without_wall(resumed) == without_wall(full)
+    assert filecmp.cmp(tmp_path / "full" / "timeseries.csv", tmp_path / "parts" / "timeseries.csv", shallow=False)
+
+
+def test_progress_reaches_the_callback_and_ctrl_c_stops_cleanly(tmp_path):
+    seen = []
+
+    def progress(p):
+        seen.append(p)
+        if len(seen) == 3:
+            os.kill(os.getpid(), signal.SIGINT)  # as a user pressing Ctrl-C
+
+    with pytest.raises(KeyboardInterrupt):
+        bendlab.shear_run(tmp_path / "run", progress=progress, progress_interval=0.0, **dict(COMMON, t_end=100.0))
+    assert len(seen) == 3 and seen[-1]["steps"] == 3 and 0 < seen[-1]["time"] < 100
+    # The folder is consistent: its checkpoint resumes (here to a short end time).
+    summary = bendlab.shear_run(tmp_path / "run", resume=True, **dict(COMMON, t_end=0.15))
+    assert summary["t_end"] == 0.15
+
+
+def test_an_exception_in_the_callback_stops_the_run_and_is_raised(tmp_path):
+    def progress(p):
+        raise RuntimeError("stop here")
+
+    with pytest.raises(RuntimeError, match="stop here"):
+        bendlab.shear_run(tmp_path / "run", progress=progress, progress_interval=0.0, **COMMON)
+
+
+def test_bad_parameters_raise_value_error_before_any_file(tmp_path):
+    with pytest.raises(ValueError, match="G"):
+        bendlab.shear_run(tmp_path / "a", **dict(COMMON, G=-1.0))
+    with pytest.raises(ValueError, match="kappa"):
+        bendlab.shear_run(tmp_path / "b", **dict(COMMON, kappa_b=1.0))  # both moduli
+    with pytest.raises(ValueError, match="no checkpoint"):
+        bendlab.shear_run(tmp_path / "c", resume=True, **COMMON)
+    with pytest.raises(ValueError, match="rings"):
+        bendlab.shear_run(tmp_path / "d", **dict(COMMON, method="E"), method_options={"rings": 9})
+    assert not any((tmp_path / n).exists() for n in "abcd")
