@@ -12,6 +12,7 @@
 
 #include "bendlab/bending/bending_method.hpp"
 #include "bendlab/capsule/capsule_run.hpp"
+#include "bendlab/capsule/run_tolerances.hpp"
 #include "bendlab/core/helper_program.hpp"
 #include "bendlab/capsule/shear_units.hpp"
 #include "bendlab/flow/bim/bim_capsule_solver.hpp"
@@ -76,8 +77,7 @@ void run_shear(const ShearArgs& a) {
   if (a.kappa_b) require_positive("--kappa-b", *a.kappa_b, true);
   require_positive("--t-end", a.t_end);
   require_positive("--snapshot-every", a.snapshot_every);
-  require_positive("--rtol", a.rtol);
-  require_positive("--atol", a.atol);
+  if (const std::string w = check_run_tolerances(a.rtol, a.atol); !w.empty()) note("warning: " + w);
   const ShearUnits units = ShearUnits::from(a.G, a.kappa_b_hat, a.kappa_b);
   if (a.method == "none" && units.kappa_b_hat > 0)
     throw Error("--kappa-b-hat or --kappa-b > 0 needs a bending --method (" + method_names_joined() + ")");
@@ -152,11 +152,12 @@ const CommandRegistration registration([](CLI::App& app) {
                               "dimensional bending modulus kB = kappa_b_hat / G (R = mu = gamma = 1)");
   hat->excludes(dim);
   cmd->add_option("--t-end", args->t_end, "end of the run in gamma t")->capture_default_str();
-  cmd->add_option("--rtol", args->rtol, "relative tolerance of the Cash-Karp stepper")->capture_default_str();
-  cmd->add_option("--atol", args->atol, "absolute tolerance of the Cash-Karp stepper, in units of R")->capture_default_str();
+  cmd->add_option("--rtol", args->rtol, "relative tolerance of the Cash-Karp stepper; above 1e-2 refused, above 1e-4 warned (less accurate D, "
+                  "theta)")->capture_default_str();
+  cmd->add_option("--atol", args->atol, "absolute tolerance of the Cash-Karp stepper, in units of R; above 1e-2 refused, above 1e-4 warned")->capture_default_str();
   cmd->add_option("--snapshot-every", args->snapshot_every, "gamma t between .vtp snapshots and checkpoints")
       ->capture_default_str();
-  cmd->add_flag("--resume", args->resume, "continue the run in --out from its last checkpoint");
+  cmd->add_flag("--resume", args->resume, "continue the run in --out from its last checkpoint (--t-end must be later than the checkpoint's time)");
   cmd->add_option("--stop-after-steps", args->stop_after_steps,
                   "stop after this many accepted steps (no summary; continue with --resume)")
       ->check(CLI::NonNegativeNumber);
