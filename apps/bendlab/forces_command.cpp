@@ -4,6 +4,7 @@
 
 #include "bendlab/analysis/error_measures.hpp"
 #include "bendlab/bending/bending_method.hpp"
+#include "bendlab/bending/result_check.hpp"
 #include "bendlab/core/csv.hpp"
 #include "bendlab/mesh/mesh_io.hpp"
 #include "cli_common.hpp"
@@ -37,6 +38,7 @@ void run_forces(const ForcesArgs& a) {
   if (surface) require_nodes_on_surface(*surface, mesh.positions(), a.surface_tolerance);
 
   const BendingResult r = method->compute(mesh.topology(), mesh.positions(), a.kappa_b);
+  require_finite_result(r, a.method);  // nothing is written from a result with NaN or infinity
   SurfaceFields exact;
   NodeErrors err;
   if (surface) {

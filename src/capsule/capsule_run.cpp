@@ -89,6 +89,10 @@ CapsuleRunResult run_capsule(CapsuleSolver& solver, const CapsuleRunOptions& o) 
     CapsuleCheckpoint saved = CapsuleCheckpoint::read(checkpoint_path, membrane.num_vertices());
     if (const std::string diff = compare_arguments(o.arguments, saved.arguments); !diff.empty())
       throw Error(fmt::format("resume: the arguments differ from the run in '{}': {}", folder.string(), diff));
+    if (!(o.t_end > saved.time))
+      throw Error(fmt::format("resume: t_end (--t-end) {} is not after the checkpoint's gamma t = {} in '{}'; a run "
+                              "continues to a later end only (start a new run in another folder instead)",
+                              o.t_end, saved.time, folder.string()));
     if (saved.solver != solver.name())
       throw Error(fmt::format("{}: \"solver\" is \"{}\", this run uses \"{}\"", checkpoint_path.string(), saved.solver,
                               solver.name()));
@@ -146,9 +150,15 @@ CapsuleRunResult run_capsule(CapsuleSolver& solver, const CapsuleRunOptions& o) 
   double last_progress = -std::numeric_limits<double>::infinity();
   std::int64_t steps_here = 0;
   bool stopped = false;
+  double last_good_time = solver.time();
+  // A step that fails (a non-finite force or velocity, a collapsing step size) ends the run with
+  // an Error that says where; the last checkpoint stays whole and resumable, and timeseries.csv
+  // keeps the rows of the accepted steps (a resume truncates them to the checkpoint's).
+  try {
   solver.advance(o.t_end, [&](const AcceptedStep& s) {
     ++state.steps;
     ++steps_here;
+    last_good_time = s.time;
     const TimeSeriesRow row = capsule_sample(membrane, *s.positions, s.time, s.dt);
     series->append(row);
     state.steady.add(row);
@@ -184,6 +194,11 @@ CapsuleRunResult run_capsule(CapsuleSolver& solver, const CapsuleRunOptions& o) 
     }
     return true;
   });
+  } catch (const Error& e) {
+    throw Error(fmt::format("the run failed after step {} (gamma t = {:.6g}): {}; the last checkpoint, at gamma t = "
+                            "{:.6g}, is whole in '{}'",
+                            state.steps, last_good_time, e.what(), state.time, checkpoint_path.string()));
+  }
   CapsuleRunResult result;
   if (stopped) return result;
 

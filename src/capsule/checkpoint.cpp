@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "bendlab/core/atomic_file.hpp"
+#include "bendlab/core/file_input.hpp"
 
 namespace bendlab {
 
@@ -147,21 +148,23 @@ void CapsuleCheckpoint::write(const std::filesystem::path& path) const {
   f.commit();
 }
 
-CapsuleCheckpoint CapsuleCheckpoint::read(const std::filesystem::path& path, int num_vertices) {
-  std::ifstream in(path);
-  if (!in) throw Error(fmt::format("cannot read the checkpoint '{}'", path.string()));
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  const std::string text = buffer.str();
+CapsuleCheckpoint CapsuleCheckpoint::parse(const std::string& text, int num_vertices, const std::string& source) {
   if (text.find_first_not_of(" \t\r\n") == std::string::npos)
-    throw Error(fmt::format("{}: the checkpoint is empty", path.string()));
+    throw Error(fmt::format("{}: the checkpoint is empty", source));
   nlohmann::json j;
   try {
     j = nlohmann::json::parse(text);
   } catch (const nlohmann::json::parse_error& e) {
-    throw Error(fmt::format("{}: not valid JSON (byte {})", path.string(), e.byte));
+    throw Error(fmt::format("{}: not valid JSON (byte {})", source, e.byte));
+  } catch (const nlohmann::json::exception& e) {
+    // e.g. a number too large for a double (out_of_range 406)
+    throw Error(fmt::format("{}: not a checkpoint: {}", source, e.what()));
   }
-  return from_json(j, num_vertices, path.string());
+  return from_json(j, num_vertices, source);
+}
+
+CapsuleCheckpoint CapsuleCheckpoint::read(const std::filesystem::path& path, int num_vertices) {
+  return parse(read_regular_file(path, "the checkpoint"), num_vertices, path.string());
 }
 
 }  // namespace bendlab

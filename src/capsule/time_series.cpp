@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "bendlab/core/atomic_file.hpp"
+#include "bendlab/core/file_input.hpp"
 
 namespace bendlab {
 
@@ -29,7 +30,7 @@ std::ifstream open_series(const std::filesystem::path& path) {
   return in;
 }
 
-double parse_number(const std::string& s, const std::filesystem::path& path, std::int64_t line) {
+double parse_number(const std::string& s, const std::string& source, std::int64_t line) {
   if (s == "nan") return std::numeric_limits<double>::quiet_NaN();
   try {
     std::size_t used = 0;
@@ -37,22 +38,30 @@ double parse_number(const std::string& s, const std::filesystem::path& path, std
     if (used == s.size()) return v;
   } catch (const std::exception&) {
   }
-  throw Error(fmt::format("'{}' line {}: '{}' is not a number", path.string(), line, s));
+  throw Error(fmt::format("'{}' line {}: '{}' is not a number", source, line, s.substr(0, 40)));
 }
 }  // namespace
 
-std::vector<TimeSeriesRow> read_time_series(const std::filesystem::path& path) {
-  std::ifstream in = open_series(path);
+std::vector<TimeSeriesRow> parse_time_series(const std::string& text, const std::string& source) {
+  std::istringstream in(text);
+  std::string header;
+  std::getline(in, header);
+  if (header != time_series_header())
+    throw Error(fmt::format("'{}': header is '{}', expected '{}'", source, header.substr(0, 200), time_series_header()));
   std::vector<TimeSeriesRow> rows;
   std::string line;
   for (std::int64_t n = 2; std::getline(in, line); ++n) {
     std::vector<double> v;
     std::istringstream s(line);
-    for (std::string cell; std::getline(s, cell, ',');) v.push_back(parse_number(cell, path, n));
-    if (v.size() != 8) throw Error(fmt::format("'{}' line {}: {} columns, expected 8", path.string(), n, v.size()));
+    for (std::string cell; std::getline(s, cell, ',');) v.push_back(parse_number(cell, source, n));
+    if (v.size() != 8) throw Error(fmt::format("'{}' line {}: {} columns, expected 8", source, n, v.size()));
     rows.push_back({v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7]});
   }
   return rows;
+}
+
+std::vector<TimeSeriesRow> read_time_series(const std::filesystem::path& path) {
+  return parse_time_series(read_regular_file(path, "the time series"), path.string());
 }
 
 TimeSeriesFile::TimeSeriesFile(std::filesystem::path path, std::int64_t rows) : path_(std::move(path)), rows_(rows) {

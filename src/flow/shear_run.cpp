@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "bendlab/bending/method_registry.hpp"
+#include "bendlab/capsule/run_tolerances.hpp"
 #include "bendlab/capsule/shear_units.hpp"
 #include "bendlab/flow/bim/bim_capsule_solver.hpp"
 #include "bendlab/integrate/cash_karp.hpp"
@@ -37,8 +38,7 @@ CapsuleRunResult run_shear(const ShearRunSpec& a, const ShearRunCallbacks& callb
   if (a.kappa_b) require_positive("--kappa-b", *a.kappa_b, true);
   require_positive("--t-end", a.t_end);
   require_positive("--snapshot-every", a.snapshot_every);
-  require_positive("--rtol", a.rtol);
-  require_positive("--atol", a.atol);
+  const std::string tolerance_warning = check_run_tolerances(a.rtol, a.atol);
   if (a.stop_after_steps < 0) throw Error("--stop-after-steps must be >= 0");
   const ShearUnits units = ShearUnits::from(a.G, a.kappa_b_hat, a.kappa_b);
   if (a.method == "none" && units.kappa_b_hat > 0)
@@ -52,6 +52,7 @@ CapsuleRunResult run_shear(const ShearRunSpec& a, const ShearRunCallbacks& callb
   if (a.resume && !fs::exists(a.folder / "checkpoint.json"))
     throw Error(fmt::format("--resume: no checkpoint in '{}' to resume from", a.folder.string()));
   const TriMesh mesh = mesh_from_spec(a.mesh);
+  if (!tolerance_warning.empty() && callbacks.on_note) callbacks.on_note("warning: " + tolerance_warning);
 
   MembraneParameters mp;
   mp.kS = units.kS();

@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "bendlab/core/finite_check.hpp"
 #include "bendlab/geometry/measures.hpp"
 #include "bendlab/geometry/mesh_geometry.hpp"
 
@@ -29,14 +30,20 @@ MembraneModel::MembraneModel(const TriMesh& reference, MembraneParameters parame
 void MembraneModel::forces(const Points& x, Points& force) const {
   if (x.rows() != topology_->num_vertices())
     throw Error(fmt::format("membrane: {} positions for {} vertices", x.rows(), topology_->num_vertices()));
+  require_finite_rows(x, "membrane: the position");
+  // Each stage is checked, so that a non-finite force names the stage it appeared in.
   elastic_->forces(x, force);
+  require_finite_rows(force, "membrane: the " + parameters_.elastic_law + " elastic force");
   if (parameters_.bending != nullptr && parameters_.kB > 0) {
     Points bending;
     parameters_.bending->forces(*topology_, x, parameters_.kB, bending);
+    require_finite_rows(bending, "membrane: the bending force of method " + parameters_.bending->name());
     force += bending;
   }
-  if (parameters_.volume_force != nullptr)
+  if (parameters_.volume_force != nullptr) {
     parameters_.volume_force->add_forces(*topology_, x, reference_volume_, force);
+    require_finite_rows(force, "membrane: the force with the volume force");
+  }
 }
 
 MembraneForces MembraneModel::evaluate(const Points& x) const {
@@ -52,6 +59,7 @@ void MembraneModel::force_density(const Points& x, Points& density) const {
   forces(x, force);
   const MeshGeometry geometry = MeshGeometry::compute(*topology_, x);
   density = force.array().colwise() / geometry.mixed_area.array();  // eq. (14)
+  require_finite_rows(density, "membrane: the force density F / A_mixed");
 }
 
 double MembraneModel::elastic_energy(const Points& x) const { return elastic_->energy(x); }

@@ -2,14 +2,17 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <limits>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 
 #include "bendlab/capsule/capsule_run.hpp"
 #include "bendlab/capsule/checkpoint.hpp"
+#include "bendlab/capsule/run_tolerances.hpp"
 #include "bendlab/capsule/shear_units.hpp"
 #include "bendlab/capsule/steady_statistics.hpp"
+#include "bendlab/core/finite_check.hpp"
 #include "bendlab/flow/bim/bim_capsule_solver.hpp"
 #include "bendlab/mesh/generators.hpp"
 
@@ -199,6 +202,7 @@ TEST_F(CapsuleRun, CheckpointIsValidatedAsAWhole) {
     auto fresh = solver();
     CapsuleRunOptions r = o;
     r.resume = true;
+    r.t_end = 0.2;  // after the checkpoint's time, so that only the checkpoint can be refused
     try {
       run_capsule(*fresh, r);
       ADD_FAILURE() << "accepted a checkpoint that should name " << expected;
@@ -292,4 +296,113 @@ TEST_F(CapsuleRun, ManyRunsInOneProcess) {
     EXPECT_GE(progress, 1);
     EXPECT_GT(r.summary.at("steps").get<int>(), 0);
   }
+}
+
+TEST_F(CapsuleRun, ResumeToAnEarlierOrEqualEndIsRefusedBeforeAnyChange) {
+  // Resuming a run that reached gamma t = 0.15 with t_end <= 0.15 would write a summary of a run
+  // that did not end at t_end: refused, and the folder stays as it was.
+  auto s = solver();
+  const fs::path run = dir / "run";
+  ASSERT_TRUE(run_capsule(*s, options(run, 0.15)).finished);
+  const std::string series = slurp(run / "timeseries.csv"), checkpoint = slurp(run / "checkpoint.json"),
+                    summary = slurp(run / "summary.json");
+  for (double t_end : {0.15, 0.1}) {
+    CapsuleRunOptions o = options(run, t_end);
+    o.resume = true;
+    auto fresh = solver();
+    try {
+      run_capsule(*fresh, o);
+      ADD_FAILURE() << "resumed to t_end = " << t_end;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("is not after the checkpoint's gamma t"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(slurp(run / "timeseries.csv"), series);
+    EXPECT_EQ(slurp(run / "checkpoint.json"), checkpoint);
+    EXPECT_EQ(slurp(run / "summary.json"), summary);
+  }
+}
+
+namespace {
+// A bending method whose forces turn NaN at vertex 7 from its `healthy`-th evaluation on: a run
+// that blows up, deterministically.
+class FailingMethod final : public BendingMethod {
+ public:
+  explicit FailingMethod(int healthy) : healthy_(healthy) {}
+  std::string name() const override { return "failing"; }
+  BendingResult compute(const Topology& t, const Points& x, double) const override {
+    BendingResult r;
+    r.force = Points::Zero(t.num_vertices(), 3);
+    if (++calls_ > healthy_) r.force(7, 1) = std::numeric_limits<double>::quiet_NaN();
+    (void)x;
+    return r;
+  }
+
+ private:
+  int healthy_;
+  mutable int calls_ = 0;
+};
+}  // namespace
+
+TEST_F(CapsuleRun, BlowUpIsDiagnosedAndKeepsTheLastCheckpoint) {
+  MembraneParameters p;
+  p.kS = ShearUnits::from(0.1, 0.0, std::nullopt).kS();
+  p.kB = 1e-3;
+  p.bending = std::make_shared<FailingMethod>(6 * 40);  // healthy for about 40 steps
+  auto m = std::make_shared<const MembraneModel>(sphere_mesh(MeshFamily::MT1, 2), p);
+  BimCapsuleSolver s(m);
+  const fs::path run = dir / "run";
+  CapsuleRunOptions o = options(run, 1.0);
+  o.snapshot_every = 0.02;
+  try {
+    run_capsule(s, o);
+    FAIL() << "the run did not notice the NaN";
+  } catch (const NonFiniteError&) {
+    FAIL() << "the run's error should be wrapped with the step and the checkpoint";
+  } catch (const Error& e) {
+    const std::string msg = e.what();
+    for (const char* part : {"bending force of method failing", "vertex 7", "the run failed after step",
+                             "gamma t = ", "checkpoint.json"})
+      EXPECT_NE(msg.find(part), std::string::npos) << part << " missing in: " << msg;
+    EXPECT_EQ(msg.find("volume gradient"), std::string::npos) << msg;
+  }
+  EXPECT_FALSE(fs::exists(run / "summary.json"));
+  // The last checkpoint is whole, finite, and a run resumes from it (here with a healthy method).
+  const CapsuleCheckpoint c = CapsuleCheckpoint::read(run / "checkpoint.json", m->num_vertices());
+  EXPECT_GT(c.time, 0.0);
+  EXPECT_TRUE(c.positions.allFinite());
+  EXPECT_GE(static_cast<std::int64_t>(read_time_series(run / "timeseries.csv").size()), c.steps);
+  p.bending = std::make_shared<FailingMethod>(1 << 30);
+  BimCapsuleSolver healthy(std::make_shared<const MembraneModel>(sphere_mesh(MeshFamily::MT1, 2), p));
+  CapsuleRunOptions r = o;
+  r.resume = true;
+  r.t_end = c.time + 0.01;
+  EXPECT_TRUE(run_capsule(healthy, r).finished);
+}
+
+TEST(FiniteCheck, FirstNonFiniteRowAndMessage) {
+  Points a = Points::Zero(5, 3);
+  EXPECT_EQ(first_non_finite_row(a), -1);
+  a(3, 2) = std::numeric_limits<double>::infinity();
+  a(4, 0) = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(first_non_finite_row(a), 3);
+  Scalars v = Scalars::Ones(4);
+  v(2) = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(first_non_finite_row(v), 2);
+  try {
+    require_finite_rows(a, "stage X: the force");
+    FAIL();
+  } catch (const NonFiniteError& e) {
+    EXPECT_EQ(e.row(), 3);
+    EXPECT_NE(std::string(e.what()).find("stage X: the force is not finite at vertex 3"), std::string::npos);
+  }
+}
+
+TEST(RunTolerances, LooseTolerancesAreRefusedOrWarned) {
+  EXPECT_EQ(check_run_tolerances(1e-7, 1e-6), "");
+  EXPECT_EQ(check_run_tolerances(1e-4, 1e-4), "");
+  EXPECT_NE(check_run_tolerances(1e-3, 1e-6).find("--rtol"), std::string::npos);
+  EXPECT_NE(check_run_tolerances(1e-7, 1e-2).find("--atol"), std::string::npos);
+  for (auto [rtol, atol] : {std::pair{0.1, 0.1}, std::pair{1e-7, 0.011}, std::pair{0.02, 1e-6}, std::pair{0.0, 1e-6},
+                            std::pair{-1.0, 1e-6}, std::pair{std::nan(""), 1e-6}})
+    EXPECT_THROW(check_run_tolerances(rtol, atol), Error) << rtol << " " << atol;
 }

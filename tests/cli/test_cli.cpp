@@ -1,13 +1,23 @@
 // The command line as a user meets it: exit codes, one-line errors, files whole or absent.
+// bendlab is started with an argument vector (posix_spawn, no shell), its stdout and stderr
+// redirected to files, so that any byte a user may put in a file name reaches it unchanged.
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
+#include <cerrno>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <sstream>
-#include <sys/wait.h>
-#include <unistd.h>
+#include <vector>
+
+extern char** environ;
 
 namespace fs = std::filesystem;
 
@@ -28,11 +38,40 @@ class Cli : public ::testing::Test {
   }
   void TearDown() override { fs::remove_all(dir); }
 
-  CliRun run(const std::string& args) {
+  /// Runs bendlab with exactly these arguments; stdout and stderr go to dir/stdout.txt and
+  /// dir/stderr.txt. The status is the exit code, or 128 + the signal that ended it.
+  CliRun run(const std::vector<std::string>& args) {
     const fs::path o = dir / "stdout.txt", e = dir / "stderr.txt";
-    const std::string cmd = std::string(BENDLAB_CLI_PATH) + " " + args + " >" + o.string() + " 2>" + e.string();
-    const int rc = std::system(cmd.c_str());
-    return {WEXITSTATUS(rc), slurp(o), slurp(e)};
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, o.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, e.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    std::vector<std::string> words{BENDLAB_CLI_PATH};
+    words.insert(words.end(), args.begin(), args.end());
+    std::vector<char*> argv;
+    for (std::string& w : words) argv.push_back(w.data());
+    argv.push_back(nullptr);
+    pid_t pid = 0;
+    const int rc = posix_spawn(&pid, BENDLAB_CLI_PATH, &actions, nullptr, argv.data(), environ);
+    posix_spawn_file_actions_destroy(&actions);
+    if (rc != 0) {
+      ADD_FAILURE() << "cannot start " << BENDLAB_CLI_PATH << ": " << std::strerror(rc);
+      return {-1, "", ""};
+    }
+    int status = 0;
+    while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+    }
+    const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    return {code, slurp(o), slurp(e)};
+  }
+  /// The same with the arguments given as words separated by single spaces (for the many tests
+  /// whose arguments hold no space; a path with spaces needs the vector form above).
+  CliRun run(const std::string& args) {
+    std::vector<std::string> words;
+    std::istringstream in(args);
+    for (std::string w; std::getline(in, w, ' ');)
+      if (!w.empty()) words.push_back(w);
+    return run(words);
   }
   static std::string slurp(const fs::path& p) {
     std::ifstream in(p);
@@ -300,4 +339,80 @@ TEST_F(Cli, ShearModuliAndMissingPlotScript) {
   r = run("shear --method C --mesh mt1:320 --G 0.1 --kappa-b-hat 0.0375 --t-end 0.006 --no-plot --resume --out " +
           out.string());
   EXPECT_EQ(r.status, 0) << r.err;
+}
+
+namespace {
+/// Every path below `root`, relative to it.
+std::set<std::string> tree(const fs::path& root) {
+  std::set<std::string> out;
+  for (const auto& entry : fs::recursive_directory_iterator(root)) out.insert(fs::relative(entry.path(), root).string());
+  return out;
+}
+}  // namespace
+
+TEST_F(Cli, FileNamesWithQuotesSpacesAndSemicolonsAreTakenLiterally) {
+  // Names a shell would split or act on: the files land exactly there and nothing else appears.
+  const fs::path base = dir / "a b;c 'd' \"e\" $(f) `g`";
+  fs::create_directories(base);
+  const std::string mesh = "m e;sh 'x' \"y\".off", forces = "f; rm -rf x 'q' \"r\".csv",
+                    rbc = "rbc out; echo \"z\" 'w'", shear = "run; touch x 'a' \"b\"";
+  CliRun r = run({"mesh", "--family", "mt1", "--level", "1", "--out", (base / mesh).string()});
+  ASSERT_EQ(r.status, 0) << r.err;
+  r = run({"forces", "--mesh", (base / mesh).string(), "--method", "C", "--out", (base / forces).string()});
+  ASSERT_EQ(r.status, 0) << r.err;
+  r = run({"rbc", "--families", "mt1", "--max-triangles", "320", "--methods", "C", "--no-plots", "--out",
+           (base / rbc).string()});
+  ASSERT_EQ(r.status, 0) << r.err;
+  r = run({"shear", "--mesh", "mt1:320", "--t-end", "0.01", "--snapshot-every", "0.01", "--no-plot", "--out",
+           (base / shear).string()});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::set<std::string> all = tree(base);
+  std::set<std::string> top;
+  for (const auto& e : fs::directory_iterator(base)) top.insert(e.path().filename().string());
+  EXPECT_EQ(top, (std::set<std::string>{mesh, forces, rbc, shear}));
+  EXPECT_TRUE(fs::is_regular_file(base / mesh));
+  EXPECT_TRUE(fs::is_regular_file(base / forces));
+  EXPECT_TRUE(fs::is_regular_file(base / rbc / "errors.csv"));
+  for (const char* f : {"timeseries.csv", "summary.json", "shapes.pvd", "checkpoint.json", "snapshot_00000.vtp"})
+    EXPECT_TRUE(fs::is_regular_file(base / shear / f)) << f;
+  for (const std::string& p : all) EXPECT_EQ(p.find(".tmp"), std::string::npos) << p;
+  // Nothing appeared beside the folder either (the test's own stdout.txt and stderr.txt aside).
+  std::set<std::string> beside;
+  for (const auto& e : fs::directory_iterator(dir)) beside.insert(e.path().filename().string());
+  EXPECT_EQ(beside, (std::set<std::string>{base.filename().string(), "stdout.txt", "stderr.txt"}));
+}
+
+TEST_F(Cli, ForcesRefusesANonFiniteResultNamingTheVertex) {
+  // A huge bending modulus on a small sphere (H^3 = 1e9) overflows F: the result is refused,
+  // naming the method, the quantity and the vertex, and no file is written.
+  const fs::path mesh = dir / "s.off", out = dir / "f.csv";
+  ASSERT_EQ(run("mesh --family mt1 --level 1 --radius 1e-3 --out " + mesh.string()).status, 0);
+  const CliRun r = run("forces --mesh " + mesh.string() + " --method C --kappa-b 1e305 --out " + out.string());
+  expect_refused(r, "method C: ", out);
+  EXPECT_NE(r.err.find("is not finite at vertex"), std::string::npos) << r.err;
+}
+
+TEST_F(Cli, ShearRefusesLooseTolerancesAndWarnsAboutLooseOnes) {
+  const fs::path out = dir / "run";
+  expect_refused(run("shear --rtol 0.1 --atol 0.1 --out " + out.string()), "--rtol", out);
+  expect_refused(run("shear --atol 0.05 --out " + out.string()), "--atol", out);
+  expect_refused(run("shear --rtol 0 --out " + out.string()), "--rtol", out);
+  const CliRun r = run("shear --mesh mt1:320 --rtol 1e-3 --t-end 0.005 --no-plot --out " + out.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("warning: --rtol 0.001 is above 0.0001"), std::string::npos) << r.err;
+}
+
+TEST_F(Cli, ShearResumeToAnEarlierOrEqualEndIsRefused) {
+  const fs::path out = dir / "run";
+  const std::string common = "shear --mesh mt1:320 --snapshot-every 0.01 --no-plot --out " + out.string();
+  ASSERT_EQ(run(common + " --t-end 0.02").status, 0);
+  const std::string summary = slurp(out / "summary.json"), series = slurp(out / "timeseries.csv");
+  for (const char* t_end : {"0.02", "0.01"}) {
+    const CliRun r = run(common + " --resume --t-end " + t_end);
+    EXPECT_NE(r.status, 0);
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_NE(r.err.find("is not after the checkpoint's gamma t"), std::string::npos) << r.err;
+    EXPECT_EQ(slurp(out / "summary.json"), summary);
+    EXPECT_EQ(slurp(out / "timeseries.csv"), series);
+  }
 }

@@ -47,6 +47,9 @@ struct CapsuleCheckpoint {
 
   /// Atomic write (temporary file + rename).
   void write(const std::filesystem::path& path) const;
+  /// Parses and validates the text of a checkpoint (what read() does after reading the file);
+  /// throws bendlab::Error, and nothing else, for any text that is not a valid checkpoint.
+  static CapsuleCheckpoint parse(const std::string& text, int num_vertices, const std::string& source);
   /// Reads and validates; throws bendlab::Error for a missing, empty, unparsable or invalid file.
   static CapsuleCheckpoint read(const std::filesystem::path& path, int num_vertices);
 };

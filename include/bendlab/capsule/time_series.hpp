@@ -29,6 +29,9 @@ std::string format_time_series_row(const TimeSeriesRow& row);
 /// All rows of a time series file; throws bendlab::Error naming the file and line for a missing
 /// file, a wrong header or a malformed row.
 std::vector<TimeSeriesRow> read_time_series(const std::filesystem::path& path);
+/// The rows of the text of a time series file (what read_time_series() does after reading it);
+/// `source` names it in errors. Throws bendlab::Error, and nothing else, for any malformed text.
+std::vector<TimeSeriesRow> parse_time_series(const std::string& text, const std::string& source);
 
 class TimeSeriesFile {
  public:

@@ -47,7 +47,9 @@ class MembraneModel {
   /// unknown elastic law or a degenerate reference triangle.
   MembraneModel(const TriMesh& reference, MembraneParameters parameters);
 
-  /// F (resized to N x 3) for positions x.
+  /// F (resized to N x 3) for positions x. Throws NonFiniteError (core/finite_check.hpp) naming
+  /// the stage (elastic law, bending method, volume force) and the first vertex where a position
+  /// or a force is not finite; force_density() also checks F / A_mixed.
   void forces(const Points& x, Points& force) const;
   /// f = F / A_mixed (resized to N x 3) for positions x (eq. (14)).
   void force_density(const Points& x, Points& density) const;

@@ -3,7 +3,9 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <limits>
 
+#include "bendlab/core/finite_check.hpp"
 #include "bendlab/flow/volume_correction.hpp"
 #include "bendlab/geometry/measures.hpp"
 #include "bendlab/integrate/cash_karp.hpp"
@@ -46,9 +48,10 @@ void BimCapsuleSolver::restart(const Points& positions, double time, double dt_n
 }
 
 void BimCapsuleSolver::velocity(const Points& x, Points& u) {
-  membrane_->force_density(x, density_);
+  membrane_->force_density(x, density_);  // checks positions and every force stage
   single_layer_.velocity(x, density_, options_.mu, u);
   u.col(0) += options_.gamma * x.col(2);  // u_inf = gamma z e_x
+  require_finite_rows(u, "BIM: the single-layer velocity");
   volume_gradient(membrane_->topology(), x, grad_);
   project_zero_flux(grad_, u);
   ++counters_.velocity_evaluations;
@@ -62,9 +65,21 @@ bool BimCapsuleSolver::advance(double t_end, const OnStep& on_step) {
   const std::int64_t rejected_before = counters_.rejected_steps;
   // The state vector is the row-major N x 3 position array, flattened.
   Eigen::VectorXd y = Eigen::Map<const Eigen::VectorXd>(x_.data(), 3 * n);
-  auto rhs = [&](double, const Eigen::VectorXd& state, Eigen::VectorXd& dydt) {
+  // A non-finite value at an accepted state (the first stage of a step, t == t_) cannot be cured
+  // by a smaller step: the run stops with the diagnosis, the time and the step. At a trial stage
+  // (t > t_) it only says that the trial step was too large: the stage returns NaN, so that the
+  // integrator rejects the step and tries a smaller one.
+  auto rhs = [&](double t, const Eigen::VectorXd& state, Eigen::VectorXd& dydt) {
     xb_ = Eigen::Map<const Points>(state.data(), n, 3);
-    velocity(xb_, u_);
+    try {
+      velocity(xb_, u_);
+    } catch (const NonFiniteError& e) {
+      if (t > t_) {
+        dydt.setConstant(std::numeric_limits<double>::quiet_NaN());
+        return;
+      }
+      throw NonFiniteError(fmt::format("{} at gamma t = {:.6g}", e.what(), t), e.row());
+    }
     dydt = Eigen::Map<const Eigen::VectorXd>(u_.data(), 3 * n);
   };
   auto on_accept = [&](double t, double dt, Eigen::VectorXd& state) {
