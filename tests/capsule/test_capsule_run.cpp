@@ -347,7 +347,7 @@ TEST_F(CapsuleRun, BlowUpIsDiagnosedAndKeepsTheLastCheckpoint) {
   MembraneParameters p;
   p.kS = ShearUnits::from(0.1, 0.0, std::nullopt).kS();
   p.kB = 1e-3;
-  p.bending = std::make_shared<FailingMethod>(6 * 40);  // healthy for about 40 steps
+  p.bending = std::make_shared<FailingMethod>(6 * 10);  // healthy for about 10 steps
   auto m = std::make_shared<const MembraneModel>(sphere_mesh(MeshFamily::MT1, 2), p);
   BimCapsuleSolver s(m);
   const fs::path run = dir / "run";
