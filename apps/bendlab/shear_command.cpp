@@ -96,12 +96,16 @@ const CommandRegistration registration([](CLI::App& app) {
                               "dimensional bending modulus kB = kappa_b_hat / G (R = mu = gamma = 1)");
   hat->excludes(dim);
   cmd->add_option("--t-end", args->t_end, "end of the run in gamma t")->capture_default_str();
-  cmd->add_option("--rtol", args->rtol, "relative tolerance of the Cash-Karp stepper; above 1e-2 refused, above 1e-4 warned (less accurate D, "
-                  "theta)")->capture_default_str();
-  cmd->add_option("--atol", args->atol, "absolute tolerance of the Cash-Karp stepper, in units of R; above 1e-2 refused, above 1e-4 warned")->capture_default_str();
+  cmd->add_option("--rtol", args->rtol,
+                  "relative tolerance of the Cash-Karp stepper; above 1e-2 refused, above 1e-4 warned (less "
+                  "accurate D, theta)")->capture_default_str();
+  cmd->add_option("--atol", args->atol,
+                  "absolute tolerance of the Cash-Karp stepper, in units of R; above 1e-2 refused, above 1e-4 warned")
+      ->capture_default_str();
   cmd->add_option("--snapshot-every", args->snapshot_every, "gamma t between .vtp snapshots and checkpoints")
       ->capture_default_str();
-  cmd->add_flag("--resume", args->resume, "continue the run in --out from its last checkpoint (--t-end must be later than the checkpoint's time)");
+  cmd->add_flag("--resume", args->resume,
+                "continue the run in --out from its last checkpoint (--t-end must be later than the checkpoint's time)");
   cmd->add_option("--stop-after-steps", args->stop_after_steps,
                   "stop after this many accepted steps (no summary; continue with --resume)")
       ->check(CLI::NonNegativeNumber);

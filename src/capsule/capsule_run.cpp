@@ -155,45 +155,45 @@ CapsuleRunResult run_capsule(CapsuleSolver& solver, const CapsuleRunOptions& o) 
   // an Error that says where; the last checkpoint stays whole and resumable, and timeseries.csv
   // keeps the rows of the accepted steps (a resume truncates them to the checkpoint's).
   try {
-  solver.advance(o.t_end, [&](const AcceptedStep& s) {
-    ++state.steps;
-    ++steps_here;
-    last_good_time = s.time;
-    const TimeSeriesRow row = capsule_sample(membrane, *s.positions, s.time, s.dt);
-    series->append(row);
-    state.steady.add(row);
-    const bool at_end = s.time >= o.t_end - 1e-12;
-    if (s.time >= next_snapshot - 1e-9 * o.snapshot_every || at_end) {
-      write_checkpoint(*s.positions, s.time);
-      next_snapshot += o.snapshot_every;
-    }
-    const double now = elapsed();
-    if (o.on_progress && (now - last_progress >= o.progress_interval_seconds || at_end)) {
-      last_progress = now;
-      CapsuleProgress p;
-      p.time = s.time;
-      p.t_start = t_start;
-      p.t_end = o.t_end;
-      p.dt = s.dt;
-      p.D = row.D;
-      p.theta = row.theta;
-      p.steps = state.steps;
-      p.elapsed_seconds = now;
-      const double done = (s.time - t_start) / (o.t_end - t_start);
-      p.eta_seconds = done > 0 ? now * (1 - done) / done : 0;
-      p.final = at_end;
-      o.on_progress(p);
-    }
-    if (o.stop_after_steps > 0 && steps_here >= o.stop_after_steps && !at_end) {
-      stopped = true;
-      return false;
-    }
-    if (o.should_stop && !at_end && o.should_stop()) {
-      stopped = true;
-      return false;
-    }
-    return true;
-  });
+    solver.advance(o.t_end, [&](const AcceptedStep& s) {
+      ++state.steps;
+      ++steps_here;
+      last_good_time = s.time;
+      const TimeSeriesRow row = capsule_sample(membrane, *s.positions, s.time, s.dt);
+      series->append(row);
+      state.steady.add(row);
+      const bool at_end = s.time >= o.t_end - 1e-12;
+      if (s.time >= next_snapshot - 1e-9 * o.snapshot_every || at_end) {
+        write_checkpoint(*s.positions, s.time);
+        next_snapshot += o.snapshot_every;
+      }
+      const double now = elapsed();
+      if (o.on_progress && (now - last_progress >= o.progress_interval_seconds || at_end)) {
+        last_progress = now;
+        CapsuleProgress p;
+        p.time = s.time;
+        p.t_start = t_start;
+        p.t_end = o.t_end;
+        p.dt = s.dt;
+        p.D = row.D;
+        p.theta = row.theta;
+        p.steps = state.steps;
+        p.elapsed_seconds = now;
+        const double done = (s.time - t_start) / (o.t_end - t_start);
+        p.eta_seconds = done > 0 ? now * (1 - done) / done : 0;
+        p.final = at_end;
+        o.on_progress(p);
+      }
+      if (o.stop_after_steps > 0 && steps_here >= o.stop_after_steps && !at_end) {
+        stopped = true;
+        return false;
+      }
+      if (o.should_stop && !at_end && o.should_stop()) {
+        stopped = true;
+        return false;
+      }
+      return true;
+    });
   } catch (const Error& e) {
     throw Error(fmt::format("the run failed after step {} (gamma t = {:.6g}): {}; the last checkpoint, at gamma t = "
                             "{:.6g}, is whole in '{}'",

@@ -156,9 +156,8 @@ CapsuleCheckpoint CapsuleCheckpoint::parse(const std::string& text, int num_vert
     j = nlohmann::json::parse(text);
   } catch (const nlohmann::json::parse_error& e) {
     throw Error(fmt::format("{}: not valid JSON (byte {})", source, e.byte));
-  } catch (const nlohmann::json::exception& e) {
-    // e.g. a number too large for a double (out_of_range 406)
-    throw Error(fmt::format("{}: not a checkpoint: {}", source, e.what()));
+  } catch (const nlohmann::json::exception& e) {  // e.g. a number beyond double's range
+    throw Error(fmt::format("{}: not a valid checkpoint ({})", source, e.what()));
   }
   return from_json(j, num_vertices, source);
 }

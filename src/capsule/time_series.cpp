@@ -47,7 +47,8 @@ std::vector<TimeSeriesRow> parse_time_series(const std::string& text, const std:
   std::string header;
   std::getline(in, header);
   if (header != time_series_header())
-    throw Error(fmt::format("'{}': header is '{}', expected '{}'", source, header.substr(0, 200), time_series_header()));
+    throw Error(
+        fmt::format("'{}': header is '{}', expected '{}'", source, header.substr(0, 200), time_series_header()));
   std::vector<TimeSeriesRow> rows;
   std::string line;
   for (std::int64_t n = 2; std::getline(in, line); ++n) {

@@ -345,7 +345,8 @@ namespace {
 /// Every path below `root`, relative to it.
 std::set<std::string> tree(const fs::path& root) {
   std::set<std::string> out;
-  for (const auto& entry : fs::recursive_directory_iterator(root)) out.insert(fs::relative(entry.path(), root).string());
+  for (const auto& entry : fs::recursive_directory_iterator(root))
+    out.insert(fs::relative(entry.path(), root).string());
   return out;
 }
 }  // namespace
