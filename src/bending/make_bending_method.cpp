@@ -6,6 +6,7 @@
 #include "bendlab/bending/farutin.hpp"
 #include "bendlab/bending/gompper_kroll.hpp"
 #include "bendlab/bending/kantor_nelson.hpp"
+#include "bendlab/bending/loop_shell.hpp"
 #include "bendlab/bending/meyer.hpp"
 #include "bendlab/bending/mixed_ed.hpp"
 
@@ -18,6 +19,7 @@ std::unique_ptr<BendingMethod> make_bending_method(const std::string& name, cons
   if (name == "D") return BelkinMethod::create(options);
   if (name == "E") return FarutinMethod::create(options);
   if (name == "ED") return MixedEDMethod::create(options);
+  if (name == "S") return LoopShellMethod::create(options);
   throw Error(fmt::format("unknown bending method '{}': expected A, B, C, D, E or ED", name));
 }
 
