@@ -80,7 +80,7 @@ const CommandRegistration registration([](CLI::App& app) {
   cmd->add_option("--mesh", args->mesh, "input mesh: .off, .obj or .ply")->required()->check(CLI::ExistingFile);
   cmd->add_option("--method", args->method, "A (Kantor-Nelson), B (Gompper-Kroll), C (Meyer), D (Belkin), "
                                             "E (Farutin), ED (E for H, K, n; D for Lap H)")
-      ->required()->check(CLI::IsMember({"A", "B", "C", "D", "E", "ED"}));
+      ->required()->check(CLI::IsMember({"A", "B", "C", "D", "E", "ED", "S"}));
   cmd->add_option("--kappa-b", args->kappa_b, "bending modulus kB")->capture_default_str();
   cmd->add_option("--rings", args->rings, "fitting support of E and ED in rings of neighbours (1, 2, 3)")
       ->check(CLI::Range(1, 3));
