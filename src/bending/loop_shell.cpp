@@ -11,6 +11,7 @@
 #include "bendlab/bending/loop_shell_limit.hpp"
 #include "bendlab/bending/loop_shell_mass.hpp"
 #include "bendlab/bending/loop_shell_patches.hpp"
+#include "bendlab/bending/loop_shell_solve.hpp"
 #include "bendlab/geometry/mesh_geometry.hpp"
 
 namespace bendlab {
@@ -28,7 +29,7 @@ std::vector<int> distinct(const std::vector<int>& values) {
 
 // Everything that depends on the connectivity only. The factorisations are used under `mutex`.
 struct LoopShellMethod::Cache {
-  Cache(const Topology& t, int gauss_points, bool solve_control)
+  Cache(const Topology& t, int gauss_points, bool solve_control, bool factorize_mass)
       : num_vertices(t.num_vertices()),
         faces(t.faces()),
         patches(loop_shell::LoopPatches::build(t)),
@@ -39,7 +40,7 @@ struct LoopShellMethod::Cache {
       limit_lu.compute(limit);
       if (limit_lu.info() != Eigen::Success) throw Error("method S: the limit-mask matrix L is singular");
     }
-    mass_ldlt.analyzePattern(mass.pattern());
+    if (factorize_mass) mass_ldlt.analyzePattern(mass.pattern());
   }
   bool matches(const Topology& t) const { return t.num_vertices() == num_vertices && t.faces() == faces; }
 
@@ -65,6 +66,7 @@ std::unique_ptr<BendingMethod> LoopShellMethod::create(const MethodOptions& opti
   Control control = Control::Solve;
   int gauss = 6;
   HMode h = HMode::Limit;
+  Solver solver = Solver::CG;
   for (const auto& [key, value] : options) {
     if (key == "control") {
       if (value == "solve")
@@ -84,15 +86,22 @@ std::unique_ptr<BendingMethod> LoopShellMethod::create(const MethodOptions& opti
         h = HMode::Projection;
       else
         throw Error("method S: option 'H' expects limit or projection, got '" + value + "'");
+    } else if (key == "solver") {
+      if (value == "cg")
+        solver = Solver::CG;
+      else if (value == "ldlt")
+        solver = Solver::LDLT;
+      else
+        throw Error("method S: option 'solver' expects cg or ldlt, got '" + value + "'");
     } else {
-      throw Error("method S: unknown option '" + key + "' (known: control, gauss, H)");
+      throw Error("method S: unknown option '" + key + "' (known: control, gauss, H, solver)");
     }
   }
-  return std::make_unique<LoopShellMethod>(control, gauss, h);
+  return std::make_unique<LoopShellMethod>(control, gauss, h, solver);
 }
 
-LoopShellMethod::LoopShellMethod(Control control, int gauss_points, HMode h_mode)
-    : control_(control), gauss_points_(gauss_points), h_mode_(h_mode) {
+LoopShellMethod::LoopShellMethod(Control control, int gauss_points, HMode h_mode, Solver solver)
+    : control_(control), gauss_points_(gauss_points), h_mode_(h_mode), solver_(solver) {
   loop_shell::dunavant_rule(gauss_points);  // validates the count
 }
 
@@ -106,7 +115,7 @@ std::shared_ptr<LoopShellMethod::Cache> LoopShellMethod::cache_for(const Topolog
   }
   // Built outside the lock (it may take a while); a concurrent builder for the same topology
   // just does the same work once more.
-  auto entry = std::make_shared<Cache>(topology, gauss_points_, control_ == Control::Solve);
+  auto entry = std::make_shared<Cache>(topology, gauss_points_, control_ == Control::Solve, solver_ == Solver::LDLT);
   std::lock_guard<std::mutex> lock(cache_mutex_);
   if (cache_.size() >= kMaxCachedTopologies && !cache_.count(&topology)) cache_.erase(cache_.begin());
   cache_[&topology] = entry;
@@ -139,11 +148,7 @@ LoopShellState LoopShellMethod::state(const Topology& topology, const Points& x,
   s.control_force = -gradient;
   SparseMatrix m = cache->mass.pattern();
   cache->mass.assemble(cache->patches, cache->bases, s.control, m);
-  std::lock_guard<std::mutex> lock(cache->mutex);
-  cache->mass_ldlt.factorize(m);
-  if (cache->mass_ldlt.info() != Eigen::Success) throw Error("method S: the mass matrix is not positive definite");
-  Eigen::MatrixXd fc = cache->mass_ldlt.solve(Eigen::MatrixXd(s.control_force));
-  s.force_coefficients = fc;
+  s.force_coefficients = solve_mass(*cache, m, Eigen::MatrixXd(s.control_force));
   return s;
 }
 
@@ -159,15 +164,11 @@ BendingResult LoopShellMethod::evaluate(const Topology& topology, const Points& 
   SparseMatrix m = cache->mass.pattern();
   Eigen::VectorXd h_rhs;
   cache->mass.assemble(cache->patches, cache->bases, control, m, project_h ? &h_rhs : nullptr);
-  Eigen::MatrixXd fc, hc;
-  {
-    std::lock_guard<std::mutex> lock(cache->mutex);
-    cache->mass_ldlt.factorize(m);
-    if (cache->mass_ldlt.info() != Eigen::Success)
-      throw Error("method S: the mass matrix is not positive definite");
-    fc = cache->mass_ldlt.solve(-Eigen::MatrixXd(gradient));
-    if (project_h) hc = cache->mass_ldlt.solve(h_rhs);
-  }
+  Eigen::MatrixXd rhs(nv, project_h ? 4 : 3);
+  rhs.leftCols(3) = -gradient;
+  if (project_h) rhs.col(3) = h_rhs;
+  const Eigen::MatrixXd solution = solve_mass(*cache, m, rhs);
+  const Eigen::MatrixXd fc = solution.leftCols(3);
   r.force_density = cache->limit * fc;
   r.area = MeshGeometry::compute(topology, x).mixed_area;
   r.force = r.force_density.array().colwise() * r.area.array();
@@ -176,12 +177,20 @@ BendingResult LoopShellMethod::evaluate(const Topology& topology, const Points& 
   if (nodal_geometry) {
     r.normal = loop_shell::limit_normals(topology, control);
     loop_shell::limit_curvatures(topology, cache->patches, control, r.H, r.K);
-    if (project_h) r.H = cache->limit * hc;
+    if (project_h) r.H = cache->limit * solution.col(3);
   } else {
     r.normal = Points::Constant(nv, 3, nan);
     r.H = r.K = Scalars::Constant(nv, nan);
   }
   return r;
+}
+
+Eigen::MatrixXd LoopShellMethod::solve_mass(Cache& cache, const SparseMatrix& m, const Eigen::MatrixXd& b) const {
+  if (solver_ == Solver::CG) return loop_shell::solve_mass_cg(m, b, kCgTolerance, 10000);
+  std::lock_guard<std::mutex> lock(cache.mutex);
+  cache.mass_ldlt.factorize(m);
+  if (cache.mass_ldlt.info() != Eigen::Success) throw Error("method S: the mass matrix is not positive definite");
+  return cache.mass_ldlt.solve(b);
 }
 
 BendingResult LoopShellMethod::compute(const Topology& topology, const Points& x, double kappa_b) const {

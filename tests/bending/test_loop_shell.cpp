@@ -225,6 +225,17 @@ TEST(LoopShell, ForceDensityHasTheConventionalSignOnTheRbc) {
   EXPECT_LT(ef / m.num_vertices() / rbc->maxima().f, 0.1);
 }
 
+TEST(LoopShell, ConjugateGradientsAgreeWithTheFactorisation) {
+  const TriMesh m = sphere_mesh(MeshFamily::MT1, 2);
+  const Points x = make_rbc()->map_from_unit_sphere(m.positions());
+  const BendingResult cg = LoopShellMethod::create({{"H", "projection"}})->compute(m.topology(), x, 1.0);
+  const BendingResult ldlt =
+      LoopShellMethod::create({{"H", "projection"}, {"solver", "ldlt"}})->compute(m.topology(), x, 1.0);
+  const double scale = ldlt.force_density.cwiseAbs().maxCoeff();
+  EXPECT_LT((cg.force_density - ldlt.force_density).cwiseAbs().maxCoeff(), 1e-8 * scale);
+  EXPECT_LT((cg.H - ldlt.H).cwiseAbs().maxCoeff(), 1e-8);
+}
+
 TEST(LoopShell, IcosahedronIsRefusedNamingAFace) {
   const TriMesh m = icosahedron();
   try {
@@ -242,6 +253,7 @@ TEST(LoopShell, OptionsAreChecked) {
   EXPECT_THROW(LoopShellMethod::create({{"gauss", "5"}}), Error);
   EXPECT_THROW(LoopShellMethod::create({{"control", "limit"}}), Error);
   EXPECT_THROW(LoopShellMethod::create({{"H", "fit"}}), Error);
+  EXPECT_THROW(LoopShellMethod::create({{"solver", "gmres"}}), Error);
   EXPECT_EQ(make_bending_method("S", {{"gauss", "12"}, {"control", "nodes"}, {"H", "projection"}})->name(), "S");
 }
 
