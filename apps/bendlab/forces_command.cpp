@@ -79,7 +79,7 @@ const CommandRegistration registration([](CLI::App& app) {
                                            "of one bending method at every vertex");
   cmd->add_option("--mesh", args->mesh, "input mesh: .off, .obj or .ply")->required()->check(CLI::ExistingFile);
   cmd->add_option("--method", args->method, "A (Kantor-Nelson), B (Gompper-Kroll), C (Meyer), D (Belkin), "
-                                            "E (Farutin), ED (E for H, K, n; D for Lap H)")
+                                            "E (Farutin), ED (E for H, K, n; D for Lap H), S (Loop subdivision)")
       ->required()->check(CLI::IsMember({"A", "B", "C", "D", "E", "ED", "S"}));
   cmd->add_option("--kappa-b", args->kappa_b, "bending modulus kB")->capture_default_str();
   cmd->add_option("--rings", args->rings, "fitting support of E and ED in rings of neighbours (1, 2, 3)")
