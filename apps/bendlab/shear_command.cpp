@@ -91,6 +91,12 @@ void run_shear(const ShearArgs& a) {
   if (a.resume && !fs::exists(fs::path(a.out) / "checkpoint.json"))
     throw Error(fmt::format("--resume: no checkpoint in '{}' to resume from", a.out));
   const TriMesh mesh = capsule_mesh(a.mesh);
+  if (bending) {
+    // One evaluation on the initial shape, so that a mesh the method refuses (Method S: two
+    // extraordinary vertices in a triangle) fails here, before the run folder is written.
+    Points probe;
+    bending->forces(mesh.topology(), mesh.positions(), 1.0, probe);
+  }
 
   MembraneParameters mp;
   mp.kS = units.kS();
