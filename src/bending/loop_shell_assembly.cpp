@@ -12,6 +12,10 @@ namespace {
 // Colours a greedy colouring may use; a patch shares control points with a few dozen others
 // (about 40 colours on the sphere meshes).
 constexpr int kMaxColours = 256;
+// Below this many faces the pass runs on one thread: each colour ends with a barrier (about 40
+// per pass), which costs more than it saves on small meshes, and far more when the threads share
+// a loaded machine.
+constexpr int kParallelFaces = 4096;
 
 }  // namespace
 
@@ -51,7 +55,7 @@ double shell_energy_mass(const LoopPatches& patches, const QuadratureBases& base
   if (h_rhs) h_rhs->setZero(control.rows());
   const TriangleRule& rule = bases.rule();
   double energy = 0.0;
-#pragma omp parallel reduction(+ : energy)
+#pragma omp parallel reduction(+ : energy) if (patches.num_faces() >= kParallelFaces)
   {
     FaceLocal local;
     local.with_mass = true;

@@ -18,14 +18,14 @@ namespace {
 
 using namespace loop_shell;
 
-struct Setup {
+struct ShellSetup {
   TriMesh mesh;
   LoopPatches patches;
   QuadratureBases bases;
   MassPattern mass;
   FaceColouring colouring;
   Points control;
-  explicit Setup(const TriMesh& m)
+  explicit ShellSetup(const TriMesh& m)
       : mesh(m),
         patches(LoopPatches::build(m.topology())),
         bases(dunavant_rule(6), {4, 5, 6}),
@@ -40,7 +40,7 @@ struct Setup {
 };
 
 TEST(LoopShellAssembly, ColoursSeparatePatchesAndCoverEveryFace) {
-  const Setup s(sphere_mesh(MeshFamily::Octa, 2));
+  const ShellSetup s(sphere_mesh(MeshFamily::Octa, 2));
   std::vector<int> seen(s.patches.num_faces(), 0);
   for (int c = 0; c < s.colouring.num_colours(); ++c) {
     std::set<int> points;
@@ -56,7 +56,7 @@ TEST(LoopShellAssembly, ColoursSeparatePatchesAndCoverEveryFace) {
 
 TEST(LoopShellAssembly, FusedAssemblyEqualsTheSerialReference) {
   for (const TriMesh& mesh : {sphere_mesh(MeshFamily::MT1, 2), sphere_mesh(MeshFamily::Octa, 2)}) {
-    const Setup s(mesh);
+    const ShellSetup s(mesh);
     Points g_ref;
     const double e_ref = shell_energy(s.patches, s.bases, s.control, 1.3, &g_ref);
     Eigen::SparseMatrix<double> m_ref = s.mass.pattern();
@@ -75,7 +75,7 @@ TEST(LoopShellAssembly, FusedAssemblyEqualsTheSerialReference) {
 }
 
 TEST(LoopShellAssembly, GradientAndMassDoNotDependOnTheThreadCount) {
-  const Setup s(sphere_mesh(MeshFamily::MT1, 2));
+  const ShellSetup s(sphere_mesh(MeshFamily::MT1, 2));
   const int before = omp_get_max_threads();
   Points g1, g2;
   Eigen::SparseMatrix<double> m1 = s.mass.pattern(), m2 = s.mass.pattern();
@@ -90,7 +90,7 @@ TEST(LoopShellAssembly, GradientAndMassDoNotDependOnTheThreadCount) {
 }
 
 TEST(LoopShellAssembly, WarmStartedSolveMeetsTheSameTolerance) {
-  const Setup s(sphere_mesh(MeshFamily::MT1, 2));
+  const ShellSetup s(sphere_mesh(MeshFamily::MT1, 2));
   Points g;
   Eigen::SparseMatrix<double> m = s.mass.pattern();
   shell_energy_mass(s.patches, s.bases, s.mass, s.colouring, s.control, 1.0, g, m);

@@ -196,12 +196,12 @@ TEST_F(Cli, MethodSRefusesAMeshWithTwoExtraordinaryVerticesInATriangle) {
   for (const std::string family : {"mt1", "octa"}) {
     const fs::path mesh = dir / (family + ".off"), out = dir / "f.csv";
     ASSERT_EQ(run("mesh --family " + family + " --level 0 --out " + mesh.string()).status, 0);
-    expect_refused(run("forces --mesh " + mesh.string() + " --method S --out " + out.string()), "no Loop patch", out);
+    expect_refused(run("forces --mesh " + mesh.string() + " --method S --out " + out.string()), "valence other than 6", out);
   }
   const fs::path run_dir = dir / "run";
   expect_refused(run("shear --method S --kappa-b-hat 0.1 --mesh mt1:20 --t-end 0.1 --no-plot --out " +
                      run_dir.string()),
-                 "no Loop patch", run_dir);
+                 "valence other than 6", run_dir);
 }
 
 TEST_F(Cli, RefusesBadArgumentsBeforeWork) {
