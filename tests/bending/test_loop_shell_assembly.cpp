@@ -55,7 +55,9 @@ TEST(LoopShellAssembly, ColoursSeparatePatchesAndCoverEveryFace) {
 }
 
 TEST(LoopShellAssembly, FusedAssemblyEqualsTheSerialReference) {
-  for (const TriMesh& mesh : {sphere_mesh(MeshFamily::MT1, 2), sphere_mesh(MeshFamily::Octa, 2)}) {
+  // The serial path (320 and 128 faces) and the coloured parallel one (5120 faces).
+  for (const TriMesh& mesh : {sphere_mesh(MeshFamily::MT1, 2), sphere_mesh(MeshFamily::Octa, 2),
+                              sphere_mesh(MeshFamily::MT1, 4)}) {
     const ShellSetup s(mesh);
     Points g_ref;
     const double e_ref = shell_energy(s.patches, s.bases, s.control, 1.3, &g_ref);
@@ -75,7 +77,8 @@ TEST(LoopShellAssembly, FusedAssemblyEqualsTheSerialReference) {
 }
 
 TEST(LoopShellAssembly, GradientAndMassDoNotDependOnTheThreadCount) {
-  const ShellSetup s(sphere_mesh(MeshFamily::MT1, 2));
+  // 5120 faces: above the size from which the pass runs on several threads.
+  const ShellSetup s(sphere_mesh(MeshFamily::MT1, 4));
   const int before = omp_get_max_threads();
   Points g1, g2;
   Eigen::SparseMatrix<double> m1 = s.mass.pattern(), m2 = s.mass.pattern();
