@@ -812,6 +812,12 @@ def add_methods(added, args, command, bendlab, work, doc, fig_dir, triangles):
                   "F_i = f_i A_mixed,i at the nodes (docs/design.md). The paper ran S with an implicit "
                   "integrator (section 4.3.1); its table 4 has no column for S. Here S uses the same explicit "
                   "Cash-Karp stepper as A-E.", ""]
+        if max(triangles) < 1280:
+            lines += ["Only the resolutions given by --triangles are here. At 1280 triangles S's explicit "
+                      "steps are about 5x smaller than C's at the start (gamma dt 9e-4 against 4.6e-3 at "
+                      "gamma t = 0.04, G = 0.05, measured when this section was first generated) and each "
+                      "step costs about twice C's, so a run to gamma t = 10 was estimated at about two hours "
+                      "on the shared 2-core machine: `--add-methods S --triangles 320,1280` adds them.", ""]
     body = section_b(results, runs, fig_dir, rel, args.t_end, none_results, suffix)
     body += section_c(results, runs, args.t_end)
     body = [l.replace("## (b) All bending methods", "### (b) Added methods").replace(

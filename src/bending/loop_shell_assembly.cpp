@@ -12,10 +12,6 @@ namespace {
 // Colours a greedy colouring may use; a patch shares control points with a few dozen others
 // (about 40 colours on the sphere meshes).
 constexpr int kMaxColours = 256;
-// Below this many faces the pass runs on one thread: each colour ends with a barrier (about 40
-// per pass), which costs more than it saves on small meshes, and far more when the threads share
-// a loaded machine.
-constexpr int kParallelFaces = 4096;
 
 }  // namespace
 
@@ -48,14 +44,14 @@ FaceColouring FaceColouring::build(const LoopPatches& patches, int num_points) {
 
 double shell_energy_mass(const LoopPatches& patches, const QuadratureBases& bases, const MassPattern& mass,
                          const FaceColouring& colouring, const Points& control, double kappa_b, Points& gradient,
-                         Eigen::SparseMatrix<double>& m, Eigen::VectorXd* h_rhs) {
+                         Eigen::SparseMatrix<double>& m, Eigen::VectorXd* h_rhs, int parallel_faces) {
   gradient.setZero(control.rows(), 3);
   double* values = m.valuePtr();
   std::fill(values, values + m.nonZeros(), 0.0);
   if (h_rhs) h_rhs->setZero(control.rows());
   const TriangleRule& rule = bases.rule();
   double energy = 0.0;
-#pragma omp parallel reduction(+ : energy) if (patches.num_faces() >= kParallelFaces)
+#pragma omp parallel reduction(+ : energy) if (patches.num_faces() >= parallel_faces)
   {
     FaceLocal local;
     local.with_mass = true;

@@ -28,10 +28,16 @@ struct FaceColouring {
   static FaceColouring build(const LoopPatches& patches, int num_points);
 };
 
+/// Meshes with fewer faces run on one thread: each colour ends with a barrier (about 40 per
+/// pass), which costs more than it saves on small meshes, and far more on a loaded machine.
+constexpr int kParallelFaces = 4096;
+
 /// E_B, and into `gradient` (resized to P's shape) dE_B/dP, into m's values (m must have
-/// mass.pattern()'s pattern) M for P, and into h_rhs (if not null) int N_I H dA.
+/// mass.pattern()'s pattern) M for P, and into h_rhs (if not null) int N_I H dA. OpenMP threads
+/// from `parallel_faces` faces on.
 double shell_energy_mass(const LoopPatches& patches, const QuadratureBases& bases, const MassPattern& mass,
                          const FaceColouring& colouring, const Points& control, double kappa_b, Points& gradient,
-                         Eigen::SparseMatrix<double>& m, Eigen::VectorXd* h_rhs = nullptr);
+                         Eigen::SparseMatrix<double>& m, Eigen::VectorXd* h_rhs = nullptr,
+                         int parallel_faces = kParallelFaces);
 
 }  // namespace bendlab::loop_shell
