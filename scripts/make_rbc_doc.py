@@ -6,7 +6,9 @@
 STUDY_DIR is the --out folder of `bendlab rbc` (after its plots were drawn). RESULTS_DIR (default
 docs/results of this repository) receives rbc.md and, in rbc/, the plots and the small tables
 (errors.csv, timings.csv, errors.json, table2.md, table3.md); the large per-node files stay in
-STUDY_DIR. --command is the command line quoted at the top of the document.
+STUDY_DIR. --command is the command line quoted at the top of the document. --polar DIR adds
+the errors of Method S with the icosahedron's vertex at the poles (the --out folder of
+`bendlab rbc --base polar --families mt1 --methods S --no-plots`) beside the default orientation.
 
 Our tables 2 and 3 are set beside the paper's, transcribed below from
   A. Guckenberger, M. P. Schraml, P. G. Chen, M. Leonetti, S. Gekle, "On the bending algorithms
@@ -15,7 +17,6 @@ Our tables 2 and 3 are set beside the paper's, transcribed below from
 The paper's tables use MT2 meshes for Methods A-E and MT1 for Method S; resolutions 320-81920.
 """
 import json
-import math
 import os
 import shutil
 import sys
@@ -63,6 +64,15 @@ MEANING2 = {"●": "convergence to zero", "○": "convergence to a systematic er
 MEANING3 = {"●": "no troubles", "○": "problems in the maximal error only",
             "■": "a significant increase of both error measures"}
 QUANTITY_NAMES = {"K": "K", "H": "H", "lapH": "Lap H", "f": "f", "n": "n"}
+S_FAMILY = "mt1"  # the paper's meshes for Method S
+# METHOD_S.md section 5 (an independent implementation of S: MT1 RBC, L P = X, 6-point rule, the
+# default icosahedron): max / avg errors by N_T, and E_B (exact 48.47346).
+METHOD_S_EXPECTED = {
+    320: {"n": (1.2e-2, 3.6e-3), "H": (0.13, 3.2e-2), "K": (0.33, 4.2e-2), "f": (0.32, 0.141), "E": 48.4662},
+    1280: {"n": (2.4e-3, 5.7e-4), "H": (5.5e-2, 9.0e-3), "K": (0.19, 1.3e-2), "f": (0.36, 0.049), "E": 48.4763},
+    5120: {"n": (1.0e-3, 8.7e-5), "H": (5.0e-2, 2.6e-3), "K": (0.19, 3.8e-3), "f": (1.7, 0.060), "E": 48.4742},
+    20480: {"n": (4.7e-4, 1.1e-5), "H": (4.9e-2, 7.2e-4), "K": (0.19, 1.1e-3), "f": (8.5, 0.072), "E": 48.4736},
+}
 COPIED = ["errors.csv", "timings.csv", "errors.json", "table2.md", "table3.md"]
 
 
@@ -116,8 +126,9 @@ def md_table(header, rows):
 
 
 def table2_section(study, family, measure):
+    # The paper's S column is on MT1 meshes (A-E on MT2): S's cells come from our MT1 fits.
     fits = {(f["method"], f["quantity"]): f for f in study["rates"]
-            if f["family"] == family and f["measure"] == measure}
+            if f["family"] == (S_FAMILY if f["method"] == "S" else family) and f["measure"] == measure}
     methods = study["options"]["methods"]
     cols = list(dict.fromkeys(methods + PAPER_METHODS))
     rows, diffs = [], []
@@ -128,8 +139,6 @@ def table2_section(study, family, measure):
             ours = f["symbol"] if f else ""
             paper = paper_cell(PAPER_TABLE2[measure], PAPER_METHODS, q, m) if q in PAPER_TABLE2[measure] else None
             paper_text = paper if paper else ("" if (m in PAPER_METHODS and q != "n") else "n/a")
-            if m == "S":
-                ours = "not implemented"
             cells.append(f"{ours or '–'} / {paper_text or '–'}")
             if f and paper and f["symbol"] != paper:
                 diffs.append([QUANTITY_NAMES[q], m, f["symbol"], paper,
@@ -140,6 +149,7 @@ def table2_section(study, family, measure):
 
 def table3_section(study, family):
     checks = {(c["method"], c["quantity"]): c for c in study["inhomogeneous"] if c["family"] == family}
+    refused = {r["method"]: r["reason"] for r in study.get("refused", []) if r["family"] == family}
     methods = study["options"]["methods"]
     cols = list(dict.fromkeys(methods + PAPER_TABLE3_METHODS))
     rows, diffs = [], []
@@ -150,32 +160,96 @@ def table3_section(study, family):
             c = checks.get((m, q))
             paper = paper_cell(PAPER_TABLE3, PAPER_TABLE3_METHODS, q, m) if q in PAPER_TABLE3 else None
             ours = f"{c['symbol']} ({c['ratio_max']:.2g} / {c['ratio_avg']:.2g})" if c and c["ratio_max"] is not None else "–"
+            if m in refused:
+                ours = "n/a¹"
             cells.append(f"{ours} / {paper or '–'}")
             if c and paper and c["symbol"] != paper:
                 diffs.append([QUANTITY_NAMES[q], m, c["symbol"], paper, explain_trouble(c, paper, factor)])
         rows.append(cells)
-    return md_table(["quantity"] + cols, rows), diffs
+    table = md_table(["quantity"] + cols, rows)
+    for m, reason in refused.items():
+        table += f"\n¹ Method {m} refuses this mesh: {reason}. (The paper's table 3 has no column for S either.)\n"
+    return table, diffs
+
+
+def rows_of(study, family, method):
+    """{triangles: {quantity: (max, avg)}} of one family and method."""
+    out = {}
+    for r in study["rows"]:
+        if r["family"] == family and r["method"] == method:
+            out.setdefault(r["triangles"], {})[r["quantity"]] = (r["max_error"], r["avg_error"])
+    return out
+
+
+def method_s_section(study, polar):
+    """Method S on MT1 beside METHOD_S.md section 5, for both icosahedron orientations."""
+    md = ["## Method S: the icosahedron's orientation\n"]
+    md.append("Method S's errors concentrate at the extraordinary (valence-5) vertices, so they depend on where "
+              "the icosahedron puts them on the RBC. **default**: vertices at (±1, ±φ, 0)/|.|, four of them on "
+              "the equator, i.e. on the RBC's rim, where the curvature is largest; **polar**: a vertex at each "
+              "pole (`icosahedron_polar()`, `bendlab rbc --base polar`). The tables above use the default. "
+              "Each cell: ours max / avg, and in brackets the ratio ours / METHOD_S.md section 5 (an "
+              "independent implementation, default orientation) for max and avg.\n")
+    for label, st in (("default", study), ("polar", polar)):
+        if st is None:
+            continue
+        rows = rows_of(st, S_FAMILY, "S")
+        if not rows:
+            continue
+        header = ["N_T"] + [f"ε_{q}" for q in ("n", "H", "K", "f")]
+        table = []
+        for n in sorted(rows):
+            cells = [str(n)]
+            for q in ("n", "H", "K", "f"):
+                mx, avg = rows[n].get(q, (None, None))
+                if mx is None:
+                    cells.append("–")
+                    continue
+                cell = f"{mx:.2g} / {avg:.2g}"
+                exp = METHOD_S_EXPECTED.get(n, {}).get(q)
+                if exp and label == "default":
+                    cell += f" ({mx / exp[0]:.2f}, {avg / exp[1]:.2f})"
+                cells.append(cell)
+            table.append(cells)
+        md.append(f"### {label} orientation (MT1)\n\n" + md_table(header, table))
+    if polar is not None:
+        md.append("\nThe polar study: `" + polar.get("command", "bendlab rbc --base polar --families mt1 --methods S")
+                  + "` (its errors.json is `rbc/errors_polar.json`).\n")
+    return md
 
 
 def main():
     args = sys.argv[1:]
     command = None
+    polar_dir = None
+    if "--polar" in args:
+        i = args.index("--polar")
+        polar_dir = args[i + 1]
+        del args[i:i + 2]
     if "--command" in args:
         i = args.index("--command")
         command = args[i + 1]
         del args[i:i + 2]
-    if not args or len(args) > 2:
+    if not args or len(args) > 2 or (polar_dir is not None and not os.path.isdir(polar_dir)):
         sys.exit(__doc__)
     study_dir = args[0]
     repo = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
     results = args[1] if len(args) > 1 else os.path.join(repo, "docs", "results")
     with open(os.path.join(study_dir, "errors.json")) as f:
         study = json.load(f)
+    polar = None
+    if polar_dir:
+        with open(os.path.join(polar_dir, "errors.json")) as f:
+            polar = json.load(f)
+        polar["command"] = (f"build/release/bendlab rbc --base polar --families mt1 --methods S "
+                            f"--max-triangles {polar['options']['max_triangles']} --no-plots --out {polar_dir}")
     asset_dir = os.path.join(results, "rbc")
     os.makedirs(asset_dir, exist_ok=True)
     pngs = sorted(n for n in os.listdir(study_dir) if n.endswith(".png"))
     for name in COPIED + pngs:
         shutil.copyfile(os.path.join(study_dir, name), os.path.join(asset_dir, name))
+    if polar_dir:
+        shutil.copyfile(os.path.join(polar_dir, "errors.json"), os.path.join(asset_dir, "errors_polar.json"))
 
     th = study["thresholds"]
     opts = study["options"]
@@ -183,7 +257,10 @@ def main():
         command = (f"build/release/bendlab rbc --max-triangles {opts['max_triangles']} "
                    f"--families {','.join(opts['families'])} --methods {','.join(opts['methods'])}"
                    + (f" --rings {opts['rings']}" if opts.get("rings") else "")
-                   + f" --out {study_dir} && /usr/bin/python3 scripts/make_rbc_doc.py {study_dir}")
+                   + f" --out {study_dir} && /usr/bin/python3 scripts/make_rbc_doc.py {study_dir}"
+                   + (f" --polar {polar_dir}" if polar_dir else ""))
+        if polar_dir:
+            command = polar["command"] + " && " + command
     md = []
     md.append("# The static red blood cell (paper section 3)\n")
     md.append("Generated; do not edit. Regenerate with\n\n```sh\n" + command + "\n```\n")
@@ -208,7 +285,7 @@ def main():
               f"■ diverges: s_tail >= {th['diverge_slope']:+} or s_last >= {th['diverge_slope']:+}; "
               f"○ converges to a systematic error: otherwise. Errors below {th['exact_error']:g} count as ●.\n")
     md.append(f"Each cell: **ours / paper**. Paper: {PAPER_SOURCE}, which uses MT2 meshes for Methods A-E "
-              "and MT1 for S, so the comparison uses our MT2 meshes. Method S is not implemented here; ED (the "
+              "and MT1 for S, so the comparison uses our MT2 meshes for A-E and our MT1 meshes for S; ED (the "
               "paper's proposed mixture: E for n, H, K and D's operator for Lap H) and the normal n are not in the paper's table. – : not computed.\n")
     for measure, title in (("max", "maximal errors"), ("avg", "average errors")):
         table, diffs = table2_section(study, "mt2", measure)
@@ -246,6 +323,8 @@ def main():
             else:
                 md.append("\nEvery cell the paper fills agrees.\n")
 
+    md += method_s_section(study, polar)
+
     md.append("## Plots\n")
     md.append("Errors against 1/h with guide slopes h^1, h^2, h^-1, h^-2 (figures 3, 5, 7, 10 and, for MT2, "
               "B.19-B.21, B.23); stars with a tick: the inhomogeneous mesh; open markers: the octahedron meshes "
@@ -264,13 +343,16 @@ def main():
     md.append("## Timings\n")
     md.append("Wall-clock seconds of one `BendingMethod::compute` (every quantity of a method), one run, on the "
               "machine that generated this page. The machine was shared and the methods use OpenMP, so times "
-              "below about 0.1 s are dominated by thread scheduling; compare the largest meshes.\n")
+              "below about 0.1 s are dominated by thread scheduling; compare the largest meshes. Method S's times include "
+              "its set-up for a new topology (patches, LU factorisation of the limit-mask matrix L, mass-matrix "
+              "pattern, face colouring), which a flow run pays once; its cost per force evaluation is measured "
+              "by bench/bench_bending.cpp (docs/design.md). n/a: the method refused the mesh.\n")
     timings = study["timings"]
     meshes = list(dict.fromkeys((t["family"], t["triangles"]) for t in timings))
     methods = opts["methods"]
     lookup = {(t["family"], t["triangles"], t["method"]): t["seconds"] for t in timings}
     md.append(md_table(["mesh"] + methods,
-                       [[f"{fam} {n}"] + [f"{lookup.get((fam, n, me), math.nan):.3g}" for me in methods]
+                       [[f"{fam} {n}"] + [f"{lookup[(fam, n, me)]:.3g}" if (fam, n, me) in lookup else "n/a" for me in methods]
                         for fam, n in meshes]))
     md.append("\nAll numbers: [rbc/errors.csv](rbc/errors.csv) (family,triangles,h,method,quantity,max_error,"
               "avg_error), [rbc/errors.json](rbc/errors.json) (also the fitted slopes), "

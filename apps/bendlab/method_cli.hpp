@@ -9,7 +9,7 @@
 
 namespace bendlab::cli {
 
-/// The registered method names joined by `separator`: "A, B, C, D, E, ED".
+/// The registered method names joined by `separator`: "A, B, C, D, E, ED, S".
 std::string method_names_joined(const std::string& separator = ", ");
 /// "none" followed by the registered method names (the --method choices of `bendlab shear`).
 std::vector<std::string> method_choices_with_none();

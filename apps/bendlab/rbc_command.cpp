@@ -22,8 +22,9 @@ namespace fs = std::filesystem;
 struct RbcArgs {
   std::vector<std::string> families = {"mt1", "mt2", "octa", "inhomogeneous"};
   std::vector<std::string> methods = bending_method_names();
-  int max_triangles = 81920;  // the paper's largest meshes; the whole study takes well under a minute
+  int max_triangles = 81920;  // the paper's largest meshes; the whole study takes a few minutes
   int rings = 0;  // 0: the methods' default
+  std::string base = "default";
   std::string out;
   bool plots = true;
   std::string plot_script;
@@ -46,6 +47,7 @@ void run_rbc(const RbcArgs& a) {
   o.families = a.families;
   o.methods = a.methods;
   o.max_triangles = a.max_triangles;
+  o.base = a.base;
   if (a.rings != 0) {
     if (a.rings < 1 || a.rings > 3) throw Error(fmt::format("--rings must be 1, 2 or 3, got {}", a.rings));
     o.method_options["rings"] = std::to_string(a.rings);
@@ -116,6 +118,11 @@ const CommandRegistration registration([](CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--rings", args->rings, "neighbour rings of the fits of Methods E and ED (1, 2 or 3; "
                                           "default: the methods' own default)");
+  cmd->add_option("--base", args->base,
+                  "icosahedron of MT1/MT2: default (vertices at (+-1, +-phi, 0), four on the rim) or polar "
+                  "(a vertex at each pole)")
+      ->check(CLI::IsMember({"default", "polar"}))
+      ->capture_default_str();
   cmd->add_option("--out", args->out, "output folder (created if missing)")->required();
   cmd->add_flag("--plots,!--no-plots", args->plots, "run scripts/plot_rbc.py on the output to draw the PNG plots "
                                                    "(default: on)");

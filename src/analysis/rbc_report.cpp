@@ -36,7 +36,8 @@ void write_timings_csv(const fs::path& path, const RbcStudyResult& s) {
   f.stream() << "family,triangles,vertices,h,method,seconds\n";
   for (const MeshRun& m : s.meshes)
     for (const MethodRun& r : m.methods)
-      f.stream() << fmt::format("{},{},{},{},{},{}\n", m.family, m.triangles, m.vertices, num(m.h), r.method,
+      if (r.refused.empty())
+        f.stream() << fmt::format("{},{},{},{},{},{}\n", m.family, m.triangles, m.vertices, num(m.h), r.method,
                                 num(r.seconds));
   f.commit();
 }
@@ -47,6 +48,7 @@ void write_values_csv(const fs::path& path, const MeshRun& m) {
   f.stream() << "method,node,theta,H,H_exact,K,K_exact,lapH,lapH_exact,f_abs,f_abs_exact,eps_n,eps_H,eps_K,"
                 "eps_lapH,eps_f\n";
   for (const MethodRun& r : m.methods) {
+    if (!r.has_nodes) continue;  // refused the mesh
     const BendingResult& v = r.result;
     const NodeErrors& e = r.node_errors;
     auto at = [](const Scalars& s, int i) { return s.size() > i ? s[i] : NAN; };
@@ -64,6 +66,7 @@ void write_values_csv(const fs::path& path, const MeshRun& m) {
 
 void write_vtk(const fs::path& dir, const MeshRun& m) {
   for (const MethodRun& r : m.methods) {
+    if (!r.has_nodes) continue;  // refused the mesh
     auto defined = [&](const Scalars& s) { return s.size() == m.vertices ? s : Scalars::Constant(m.vertices, NAN); };
     auto defined3 = [&](const Points& p) { return p.rows() == m.vertices ? p : Points::Constant(m.vertices, 3, NAN); };
     VertexFields fields;
@@ -94,6 +97,7 @@ nlohmann::json to_json(const RbcStudyResult& s, const std::vector<ErrorRow>& row
   j["options"] = {{"families", s.options.families},
                   {"methods", s.options.methods},
                   {"max_triangles", s.options.max_triangles},
+                  {"base", s.options.base},
                   {"rings", rings}};
   j["thresholds"] = {{"tail_points", ct.tail_points},
                      {"to_zero_slope", ct.to_zero_slope},
@@ -121,11 +125,19 @@ nlohmann::json to_json(const RbcStudyResult& s, const std::vector<ErrorRow>& row
   j["timings"] = json::array();
   for (const MeshRun& m : s.meshes)
     for (const MethodRun& r : m.methods)
-      j["timings"].push_back({{"family", m.family},
+      if (r.refused.empty())
+        j["timings"].push_back({{"family", m.family},
                               {"triangles", m.triangles},
                               {"vertices", m.vertices},
                               {"method", r.method},
                               {"seconds", r.seconds}});
+  // Meshes a method refused (needs_admissible_mesh), with its one-line reason.
+  j["refused"] = json::array();
+  for (const MeshRun& m : s.meshes)
+    for (const MethodRun& r : m.methods)
+      if (!r.refused.empty())
+        j["refused"].push_back({{"family", m.family}, {"triangles", m.triangles}, {"method", r.method},
+                                {"reason", r.refused}});
   j["rates"] = json::array();
   for (const RateFit& f : fits) {
     std::vector<json> err;
@@ -192,8 +204,13 @@ std::string table3_text(const std::vector<InhomogeneityCheck>& checks, const Rbc
     std::vector<InhomogeneityCheck> mine;
     for (const auto& c : checks)
       if (c.family == m.family) mine.push_back(c);
+    std::vector<std::string> refused;
+    for (const MethodRun& r : m.methods)
+      if (!r.refused.empty()) refused.push_back(r.method);
     md += fmt::format("\n## {} ({} triangles, h = {:.4f}) against {}\n\n{}", m.family, m.triangles, m.h, m.origin,
-                      table3_markdown(mine, s.options.methods));
+                      table3_markdown(mine, s.options.methods, refused));
+    for (const MethodRun& r : m.methods)
+      if (!r.refused.empty()) md += fmt::format("\nn/a: method {} refuses this mesh: {}\n", r.method, r.refused);
   }
   return md;
 }

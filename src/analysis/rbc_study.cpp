@@ -49,6 +49,16 @@ std::vector<MeshSpec> mesh_specs(const RbcStudyOptions& o) {
   return specs;
 }
 
+// sphere_mesh(), or with the icosahedron rotated to a vertex at each pole.
+TriMesh study_sphere(const MeshSpec& spec, const std::string& base) {
+  if (base != "polar" || spec.generator == MeshFamily::Octa)
+    return sphere_mesh(spec.generator, spec.level, spec.passes);
+  TriMesh m = icosahedron_polar();
+  for (int k = 0; k < spec.level; ++k) m = spec.generator == MeshFamily::MT1 ? refine_loop(m) : refine_midpoint(m);
+  for (int p = 0; p < spec.passes; ++p) m = rivara_pass(m);
+  return m;
+}
+
 void report(const RbcStudyOptions& o, const std::string& line) {
   if (o.progress) o.progress(line);
 }
@@ -81,6 +91,8 @@ void validate(const RbcStudyOptions& o) {
       throw Error(fmt::format("--methods: {}", e.what()));
     }
   }
+  if (o.base != "default" && o.base != "polar")
+    throw Error(fmt::format("--base: expected default or polar, got '{}'", o.base));
   if (o.max_triangles < kMinTriangles)
     throw Error(fmt::format("--max-triangles: must be at least {} (the coarsest mesh), got {}", kMinTriangles,
                             o.max_triangles));
@@ -122,7 +134,7 @@ RbcStudyResult run_rbc_study(const RbcStudyOptions& o) {
   for (const std::string& m : o.methods) methods.push_back(make_bending_method(m, options_for(o, m)));
 
   for (const MeshSpec& spec : mesh_specs(o)) {
-    const TriMesh sphere = sphere_mesh(spec.generator, spec.level, spec.passes);
+    const TriMesh sphere = study_sphere(spec, o.base);
     const TriMesh mesh(sphere.topology_ptr(), rbc->map_from_unit_sphere(sphere.positions()));
     MeshRun run;
     run.family = spec.family;
@@ -141,7 +153,18 @@ RbcStudyResult run_rbc_study(const RbcStudyOptions& o) {
       MethodRun mr;
       mr.method = method->name();
       const auto t0 = std::chrono::steady_clock::now();
-      BendingResult result = method->compute(mesh.topology(), mesh.positions(), o.kappa_b);
+      BendingResult result;
+      try {
+        result = method->compute(mesh.topology(), mesh.positions(), o.kappa_b);
+      } catch (const Error& e) {
+        if (!bending_method_info(mr.method).capabilities.needs_admissible_mesh) throw;
+        mr.refused = e.what();
+        mr.errors.assign(kAllQuantities.size(), ErrorSummary{});
+        report(o, fmt::format("rbc: {} {} triangles, method {}: refused ({})", run.family, run.triangles,
+                              mr.method, mr.refused));
+        run.methods.push_back(std::move(mr));
+        continue;
+      }
       mr.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       NodeErrors errors = node_errors(analytic, out.maxima, result, o.kappa_b);
       for (Quantity q : kAllQuantities) mr.errors.push_back(summarize(errors[q]));
@@ -198,14 +221,17 @@ std::string table2_markdown(const std::vector<RateFit>& fits, const std::string&
   return md;
 }
 
-std::string table3_markdown(const std::vector<InhomogeneityCheck>& checks, const std::vector<std::string>& methods) {
+std::string table3_markdown(const std::vector<InhomogeneityCheck>& checks, const std::vector<std::string>& methods,
+                            const std::vector<std::string>& refused) {
   std::string md = table_header(methods);
   for (const std::string& q : kTableQuantities) {
     md += "| " + q + " |";
     for (const std::string& m : methods) {
       auto it = std::find_if(checks.begin(), checks.end(),
                              [&](const InhomogeneityCheck& c) { return c.method == m && c.quantity == q; });
-      if (it == checks.end())
+      if (std::find(refused.begin(), refused.end(), m) != refused.end())
+        md += " n/a |";
+      else if (it == checks.end())
         md += "  |";
       else
         md += fmt::format(" {} ({:.2g} / {:.2g}) |", symbol(it->trouble), it->ratio_max, it->ratio_avg);

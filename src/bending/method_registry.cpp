@@ -16,6 +16,7 @@
 #include "bendlab/bending/farutin.hpp"
 #include "bendlab/bending/gompper_kroll.hpp"
 #include "bendlab/bending/kantor_nelson.hpp"
+#include "bendlab/bending/loop_shell.hpp"
 #include "bendlab/bending/meyer.hpp"
 #include "bendlab/bending/mixed_ed.hpp"
 
@@ -23,11 +24,13 @@ namespace bendlab {
 
 namespace {
 
-/// The built-in methods, in the order of the paper's table 1 (then the conclusion's ED).
+/// The built-in methods, in the order of the paper's table 1 (then the conclusion's ED, then
+/// section 2.5's S).
 /// A new built-in method adds its line here.
 std::vector<MethodInfo> builtin_methods() {
   return {KantorNelson::info(), GompperKroll::info(), MeyerMethod::info(),
-          BelkinMethod::info(), FarutinMethod::info(), MixedEDMethod::info()};
+          BelkinMethod::info(), FarutinMethod::info(), MixedEDMethod::info(),
+          LoopShellMethod::info()};
 }
 
 bool valid_name(const std::string& name) {

@@ -52,6 +52,12 @@ CapsuleRunResult run_shear(const ShearRunSpec& a, const ShearRunCallbacks& callb
   if (a.resume && !fs::exists(a.folder / "checkpoint.json"))
     throw Error(fmt::format("--resume: no checkpoint in '{}' to resume from", a.folder.string()));
   const TriMesh mesh = mesh_from_spec(a.mesh);
+  if (bending) {
+    // One evaluation on the initial shape, so that a mesh the method refuses (Method S: two
+    // extraordinary vertices in a triangle) fails here, before the run folder is written.
+    Points probe;
+    bending->forces(mesh.topology(), mesh.positions(), 1.0, probe);
+  }
   if (!tolerance_warning.empty() && callbacks.on_note) callbacks.on_note("warning: " + tolerance_warning);
 
   MembraneParameters mp;

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <vector>
 
+#include <Eigen/Geometry>
+
 #include "bendlab/mesh/subdivision.hpp"
 
 namespace bendlab {
@@ -49,6 +51,16 @@ TriMesh icosahedron() {
       3, 9, 4, 3, 4, 2, 3, 2, 6, 3, 6, 8, 3, 8, 9,        //
       4, 9, 5, 2, 4, 11, 6, 2, 10, 8, 6, 7, 9, 8, 1;
   return TriMesh(std::move(x), f);
+}
+
+TriMesh icosahedron_polar() {
+  const TriMesh ico = icosahedron();
+  const Mat3 r = Eigen::Quaterniond::FromTwoVectors(row(ico.positions(), 0), Vec3::UnitZ()).toRotationMatrix();
+  Points x = ico.positions() * r.transpose();
+  project_rows(x, 0);
+  x.row(0) << 0, 0, 1;
+  x.row(3) << 0, 0, -1;
+  return TriMesh(std::move(x), ico.faces());
 }
 
 TriMesh octahedron() {

@@ -107,3 +107,46 @@ TEST(RbcStudy, InhomogeneousMeshesComeFromTheirFamilies) {
     EXPECT_EQ(m.triangles % 2, 0);  // a closed triangle mesh has an even face count
   }
 }
+
+TEST(RbcStudy, MethodSRefusesTheRivaraMeshesWithoutEndingTheStudy) {
+  RbcStudyOptions o;
+  o.families = {"mt1", "inhomogeneous"};
+  o.methods = {"C", "S"};
+  o.max_triangles = 320;
+  const RbcStudyResult r = run_rbc_study(o);
+  ASSERT_EQ(r.meshes.size(), 3u);
+  // MT1 meshes are admissible for S: errors available.
+  EXPECT_TRUE(r.meshes[0].methods[1].refused.empty());
+  EXPECT_TRUE(r.meshes[0].methods[1].errors[static_cast<std::size_t>(Quantity::F)].available);
+  for (std::size_t k = 1; k < 3; ++k) {
+    const MeshRun& m = r.meshes[k];
+    EXPECT_TRUE(m.methods[0].refused.empty()) << m.family;  // C runs
+    const MethodRun& s = m.methods[1];
+    EXPECT_NE(s.refused.find("method S: face"), std::string::npos) << s.refused;
+    EXPECT_FALSE(s.has_nodes);
+    for (const ErrorSummary& e : s.errors) EXPECT_FALSE(e.available);
+  }
+  // No rows for the refused runs; table 3 shows n/a for S.
+  for (const ErrorRow& row : r.rows()) EXPECT_FALSE(row.method == "S" && row.family != "mt1") << row.family;
+  const std::string md = table3_markdown({}, {"C", "S"}, {"S"});
+  EXPECT_NE(md.find("| n/a |"), std::string::npos) << md;
+}
+
+TEST(RbcStudy, PolarBaseRotatesTheIcosahedron) {
+  RbcStudyOptions o;
+  o.families = {"mt1"};
+  o.methods = {"C"};
+  o.max_triangles = 320;
+  o.base = "polar";
+  const RbcStudyResult r = run_rbc_study(o);
+  ASSERT_EQ(r.meshes.size(), 1u);
+  // Vertices 0 and 3 (the icosahedron's, kept by refinement) sit at the poles in the polar base,
+  // not in the default one.
+  EXPECT_NEAR(r.meshes[0].theta[0], 0.0, 1e-12);
+  EXPECT_NEAR(r.meshes[0].theta[3], std::numbers::pi, 1e-12);
+  o.base = "default";
+  const RbcStudyResult d = run_rbc_study(o);
+  EXPECT_GT(d.meshes[0].theta[0], 0.1);
+  o.base = "sideways";
+  EXPECT_THROW(validate(o), Error);
+}

@@ -49,10 +49,10 @@ MethodInfo toy_info() {
 
 TEST(MethodRegistry, ListsTheBuiltInsInTableOrder) {
   const std::vector<std::string> names = bending_method_names();
-  ASSERT_GE(names.size(), 6u);
-  EXPECT_EQ(std::vector<std::string>(names.begin(), names.begin() + 6),
-            (std::vector<std::string>{"A", "B", "C", "D", "E", "ED"}));
-  for (const std::string& n : {"A", "B", "C", "D", "E", "ED"}) {
+  ASSERT_GE(names.size(), 7u);
+  EXPECT_EQ(std::vector<std::string>(names.begin(), names.begin() + 7),
+            (std::vector<std::string>{"A", "B", "C", "D", "E", "ED", "S"}));
+  for (const std::string& n : {"A", "B", "C", "D", "E", "ED", "S"}) {
     const MethodInfo& info = bending_method_info(n);
     EXPECT_FALSE(info.description.empty()) << n;
     // The factory makes the method of that name, with the defaults.
@@ -66,6 +66,15 @@ TEST(MethodRegistry, ListsTheBuiltInsInTableOrder) {
   EXPECT_EQ(bending_method_info("D").capabilities.cost, "O(N^2)");
   EXPECT_EQ(bending_method_info("E").options.size(), 1u);
   EXPECT_EQ(bending_method_info("E").options[0].name, "rings");
+  const MethodInfo& s = bending_method_info("S");
+  EXPECT_TRUE(s.capabilities.has_energy);
+  EXPECT_FALSE(s.capabilities.defines_lapH);
+  EXPECT_TRUE(s.capabilities.needs_admissible_mesh);
+  ASSERT_EQ(s.options.size(), 4u);
+  EXPECT_EQ(s.options[1].name, "gauss");
+  EXPECT_EQ(s.options[1].default_value, "6");
+  expect_error_naming([] { make_bending_method("S", {{"gauss", "5"}}); }, "gauss");
+  expect_error_naming([] { make_bending_method("S", {{"solver", "lu"}}); }, "solver");
   EXPECT_EQ(find_bending_method("Z"), nullptr);
   expect_error_naming([] { bending_method_info("Z"); }, "'Z'");
   expect_error_naming([] { make_bending_method("Z"); }, "ED");  // the message lists the known methods

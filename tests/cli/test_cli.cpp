@@ -163,7 +163,8 @@ TEST_F(Cli, MethodsListsTheRegistryAsTableAndJson) {
                             "needs_admissible_mesh", "cost"})
       EXPECT_TRUE(m["capabilities"].contains(key)) << key;
   }
-  EXPECT_EQ(names, (std::vector<std::string>{"A", "B", "C", "D", "E", "ED"}));
+  EXPECT_EQ(names, (std::vector<std::string>{"A", "B", "C", "D", "E", "ED", "S"}));
+  EXPECT_TRUE(j[6]["capabilities"]["needs_admissible_mesh"].get<bool>());
   EXPECT_TRUE(j[0]["capabilities"]["has_energy"].get<bool>());
   EXPECT_FALSE(j[2]["capabilities"]["has_energy"].get<bool>());
   EXPECT_EQ(j[3]["capabilities"]["cost"], "O(N^2)");
@@ -227,6 +228,19 @@ TEST_F(Cli, RefusesBadMeshesWithOneLineNamingTheProblem) {
     expect_refused(run("shape --mesh " + in.string() + " --shape sphere --out " + out.string()), problem, out);
     expect_refused(run("forces --mesh " + in.string() + " --method C --out " + out.string()), problem, out);
   }
+}
+
+TEST_F(Cli, MethodSRefusesAMeshWithTwoExtraordinaryVerticesInATriangle) {
+  // The bare icosahedron and octahedron: every triangle has three vertices of valence != 6.
+  for (const std::string family : {"mt1", "octa"}) {
+    const fs::path mesh = dir / (family + ".off"), out = dir / "f.csv";
+    ASSERT_EQ(run("mesh --family " + family + " --level 0 --out " + mesh.string()).status, 0);
+    expect_refused(run("forces --mesh " + mesh.string() + " --method S --out " + out.string()), "valence other than 6", out);
+  }
+  const fs::path run_dir = dir / "run";
+  expect_refused(run("shear --method S --kappa-b-hat 0.1 --mesh mt1:20 --t-end 0.1 --no-plot --out " +
+                     run_dir.string()),
+                 "valence other than 6", run_dir);
 }
 
 TEST_F(Cli, RefusesBadArgumentsBeforeWork) {

@@ -87,6 +87,18 @@ TEST(GeneratorPlatonic, IcosahedronAndOctahedron) {
   EXPECT_EQ(count_valence(oct, 4), 6);
 }
 
+TEST(GeneratorPlatonic, PolarIcosahedronIsARotation) {
+  const TriMesh ico = icosahedron(), polar = icosahedron_polar();
+  expect_valid_sphere(polar);
+  EXPECT_LT((polar.position(0) - Vec3(0, 0, 1)).norm(), 1e-15);
+  EXPECT_LT((polar.position(3) - Vec3(0, 0, -1)).norm(), 1e-15);
+  // Same faces, same pairwise distances.
+  EXPECT_EQ(polar.faces(), ico.faces());
+  for (int i = 0; i < 12; ++i)
+    for (int j = 0; j < 12; ++j)
+      EXPECT_NEAR((polar.position(i) - polar.position(j)).norm(), (ico.position(i) - ico.position(j)).norm(), 1e-14);
+}
+
 TEST(GeneratorFamilies, TriangleCountsAndInvariants) {
   for (MeshFamily fam : {MeshFamily::MT1, MeshFamily::MT2}) {
     for (int k = 0; k <= 6; ++k) {

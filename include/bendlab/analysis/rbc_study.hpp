@@ -10,7 +10,8 @@
 //   "octa"             levels 3, 4, ... : N_T = 512, 2048, 8192, ...
 //   "inhomogeneous"    "rivara-mt1" and "rivara-mt2": level 2 (320 triangles) of MT1 / MT2, then
 //                      three Rivara passes (about 3900 triangles). These two meshes are run
-//                      whatever max_triangles is, because table 3 needs them.
+//                      whatever max_triangles is, because table 3 needs them. Method S refuses
+//                      them (MethodRun::refused).
 // h is the mean edge length of the mapped (RBC) mesh.
 #include <functional>
 #include <string>
@@ -32,6 +33,11 @@ struct RbcStudyOptions {
   /// E and ED); an option that no registered method takes is an error.
   MethodOptions method_options;
   int max_triangles = 5120;
+  /// Orientation of the icosahedron of MT1 and MT2: "default" (vertices at (+-1, +-phi, 0) / |.|,
+  /// four on the equator, i.e. on the RBC's rim) or "polar" (icosahedron_polar(): a vertex at each
+  /// pole). Method S's errors depend on it (the extraordinary vertices' positions); the other
+  /// methods' hardly.
+  std::string base = "default";
   double kappa_b = 1.0;
   double radius = 1.0;
   /// Per-node data (numerical results, errors) are kept for meshes with N_T <= this, and for the
@@ -49,6 +55,11 @@ void validate(const RbcStudyOptions& options);
 
 struct MethodRun {
   std::string method;
+  /// Non-empty when the method refused the mesh (the bendlab::Error it threw, one line): only a
+  /// method whose capabilities say needs_admissible_mesh may refuse (Method S on the Rivara
+  /// meshes, two extraordinary vertices in a triangle); its errors are then all unavailable and
+  /// the tables show n/a with this reason. Any other method's Error ends the study.
+  std::string refused;
   double seconds = 0;                  ///< wall time of BendingMethod::compute
   std::vector<ErrorSummary> errors;    ///< by kAllQuantities
   bool has_nodes = false;
@@ -88,7 +99,9 @@ Scalars polar_angle(const Points& x);
 /// one column per method; each cell the symbol and the slope on the finest meshes.
 std::string table2_markdown(const std::vector<RateFit>& fits, const std::string& family, const std::string& measure,
                             const std::vector<std::string>& methods);
-/// Markdown of table 3 for one inhomogeneous family: symbol and the ratios max / avg.
-std::string table3_markdown(const std::vector<InhomogeneityCheck>& checks, const std::vector<std::string>& methods);
+/// Markdown of table 3 for one inhomogeneous family: symbol and the ratios max / avg; "n/a" for the
+/// methods in `refused` (they refused the mesh).
+std::string table3_markdown(const std::vector<InhomogeneityCheck>& checks, const std::vector<std::string>& methods,
+                            const std::vector<std::string>& refused = {});
 
 }  // namespace bendlab

@@ -22,6 +22,10 @@ std::string to_string(MeshFamily family);
 
 /// Regular icosahedron (12 vertices, 20 faces) with its vertices on the unit sphere.
 TriMesh icosahedron();
+/// The same icosahedron rotated so that vertex 0 sits at the north pole (0, 0, 1) and vertex 3 at
+/// the south pole (the default places vertices at (+-1, +-phi, 0) / |.|, four of them on the
+/// equator z = 0). Same faces; MT1 meshes from it: refine_loop k times.
+TriMesh icosahedron_polar();
 /// Regular octahedron (6 vertices, 8 faces) with its vertices on the unit sphere.
 TriMesh octahedron();
 

@@ -1,0 +1,34 @@
+#pragma once
+// Method S (paper section 2.5): values at the limit points of the nodes (METHOD_S.md sections
+// 2 and 4.2).
+//
+//   limit position  x_i = (1 - N chi) P_i + chi sum_ring P_j, chi = 1 / (N + 3 / (8 beta_N));
+//   tangents        t1 = sum_j cos(2 pi j / N) P_j, t2 = sum_j sin(2 pi j / N) P_j over the
+//                   counter-clockwise ring; n_i = t1 x t2 / |t1 x t2| (outward);
+//   H, K            at a regular node: one incident patch evaluated at its corner; at an
+//                   extraordinary node (valence != 6) they are not defined at the point itself
+//                   (the surface is only C1 there): the mean over the incident patches at
+//                   v = w = 1e-3 (the EV corner is u = 1) is reported.
+#include <Eigen/Sparse>
+
+#include "bendlab/bending/loop_shell_patches.hpp"
+#include "bendlab/core/types.hpp"
+#include "bendlab/mesh/topology.hpp"
+
+namespace bendlab::loop_shell {
+
+/// Distance (in v = w) from an extraordinary node at which its H and K are sampled.
+inline constexpr double kExtraordinarySample = 1e-3;
+
+/// The limit-mask matrix L (N x N, row i: 1 - N_i chi at i, chi at each ring vertex), so that
+/// L P gives the limit points of control points P. Rows sum to 1.
+Eigen::SparseMatrix<double> limit_matrix(const Topology& topology);
+
+/// Outward unit normals of the limit surface at the limit points of the nodes.
+Points limit_normals(const Topology& topology, const Points& control);
+
+/// H and K of the limit surface at the nodes' limit points (see the header comment).
+void limit_curvatures(const Topology& topology, const LoopPatches& patches, const Points& control, Scalars& H,
+                      Scalars& K);
+
+}  // namespace bendlab::loop_shell

@@ -1,0 +1,217 @@
+#include "bendlab/bending/loop_shell.hpp"
+
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseLU>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <set>
+
+#include "bendlab/bending/loop_shell_assembly.hpp"
+#include "bendlab/bending/loop_shell_energy.hpp"
+#include "bendlab/bending/loop_shell_limit.hpp"
+#include "bendlab/bending/loop_shell_mass.hpp"
+#include "bendlab/bending/loop_shell_patches.hpp"
+#include "bendlab/bending/loop_shell_solve.hpp"
+#include "bendlab/bending/method_registry.hpp"
+#include "bendlab/geometry/mesh_geometry.hpp"
+
+namespace bendlab {
+
+using SparseMatrix = Eigen::SparseMatrix<double>;
+
+namespace {
+
+std::vector<int> distinct(const std::vector<int>& values) {
+  const std::set<int> s(values.begin(), values.end());
+  return {s.begin(), s.end()};
+}
+
+}  // namespace
+
+// Everything that depends on the connectivity only. The factorisations are used under `mutex`.
+struct LoopShellMethod::Cache {
+  Cache(const Topology& t, int gauss_points, bool solve_control, bool factorize_mass)
+      : num_vertices(t.num_vertices()),
+        faces(t.faces()),
+        patches(loop_shell::LoopPatches::build(t)),
+        bases(loop_shell::dunavant_rule(gauss_points), distinct(patches.valence)),
+        limit(loop_shell::limit_matrix(t)),
+        mass(patches, t.num_vertices()),
+        colouring(loop_shell::FaceColouring::build(patches, t.num_vertices())) {
+    if (solve_control) {
+      limit_lu.compute(limit);
+      if (limit_lu.info() != Eigen::Success) throw Error("method S: the limit-mask matrix L is singular");
+    }
+    if (factorize_mass) mass_ldlt.analyzePattern(mass.pattern());
+  }
+  bool matches(const Topology& t) const { return t.num_vertices() == num_vertices && t.faces() == faces; }
+
+  int num_vertices;
+  Faces faces;
+  loop_shell::LoopPatches patches;
+  loop_shell::QuadratureBases bases;
+  SparseMatrix limit;
+  loop_shell::MassPattern mass;
+  loop_shell::FaceColouring colouring;
+  std::mutex mutex;
+  // The last solution of M f_c = F_c (under `mutex`): the next CG solve on this topology starts
+  // from it. Successive shapes of a flow run differ little, so this saves most iterations; the
+  // result still meets the same residual tolerance.
+  Eigen::MatrixXd last_solution;
+  Eigen::SparseLU<SparseMatrix> limit_lu;
+  Eigen::SimplicialLDLT<SparseMatrix> mass_ldlt;
+};
+
+namespace {
+
+// Topologies whose caches are kept at once (a flow solver and a study use one or a few).
+constexpr size_t kMaxCachedTopologies = 8;
+
+}  // namespace
+
+std::unique_ptr<BendingMethod> LoopShellMethod::create(const MethodOptions& options) {
+  const MethodOptions o = resolve_method_options(info(), options);
+  const Control control = o.at("control") == "nodes" ? Control::Nodes : Control::Solve;
+  const int gauss = std::stoi(o.at("gauss"));
+  const HMode h = o.at("H") == "projection" ? HMode::Projection : HMode::Limit;
+  const Solver solver = o.at("solver") == "ldlt" ? Solver::LDLT : Solver::CG;
+  return std::make_unique<LoopShellMethod>(control, gauss, h, solver);
+}
+
+MethodInfo LoopShellMethod::info() {
+  MethodInfo m{"S",
+               "Loop subdivision thin shell: Helfrich energy on the limit surface, f from the weak form "
+               "(section 2.5)",
+               {choice_option("control", {"solve", "nodes"}, "solve",
+                              "control points: solve L P = X (nodes are limit points) or P = X"),
+                choice_option("gauss", {"1", "3", "6", "7", "12"}, "6", "quadrature points per triangle"),
+                choice_option("H", {"limit", "projection"}, "limit",
+                              "nodal H: the limit surface's own, or its L2 projection"),
+                choice_option("solver", {"cg", "ldlt"}, "cg", "mass-matrix solve M f_c = F_c")},
+               {},
+               &LoopShellMethod::create};
+  m.capabilities.has_energy = true;
+  m.capabilities.defines_lapH = false;
+  // At most one extraordinary vertex per triangle (the bare icosahedron and Rivara meshes are refused).
+  m.capabilities.needs_admissible_mesh = true;
+  m.capabilities.cost = "O(N) per patch + two sparse solves (L P = X, M f_c = F_c)";
+  return m;
+}
+
+LoopShellMethod::LoopShellMethod(Control control, int gauss_points, HMode h_mode, Solver solver)
+    : control_(control), gauss_points_(gauss_points), h_mode_(h_mode), solver_(solver) {
+  loop_shell::dunavant_rule(gauss_points);  // validates the count
+}
+
+LoopShellMethod::~LoopShellMethod() = default;
+
+std::shared_ptr<LoopShellMethod::Cache> LoopShellMethod::cache_for(const Topology& topology) const {
+  {
+    std::lock_guard<std::mutex> lock(cache_mutex_);
+    auto it = cache_.find(&topology);
+    if (it != cache_.end() && it->second->matches(topology)) return it->second;
+  }
+  // Built outside the lock (it may take a while); a concurrent builder for the same topology
+  // just does the same work once more.
+  auto entry = std::make_shared<Cache>(topology, gauss_points_, control_ == Control::Solve, solver_ == Solver::LDLT);
+  std::lock_guard<std::mutex> lock(cache_mutex_);
+  if (cache_.size() >= kMaxCachedTopologies && !cache_.count(&topology)) cache_.erase(cache_.begin());
+  cache_[&topology] = entry;
+  return entry;
+}
+
+Points LoopShellMethod::control_points(const Topology& topology, const Points& x) const {
+  if (x.rows() != topology.num_vertices())
+    throw Error("method S: " + std::to_string(x.rows()) + " positions for " +
+                std::to_string(topology.num_vertices()) + " vertices");
+  if (control_ == Control::Nodes) return x;
+  auto cache = cache_for(topology);
+  std::lock_guard<std::mutex> lock(cache->mutex);
+  Eigen::MatrixXd p = cache->limit_lu.solve(Eigen::MatrixXd(x));
+  return p;
+}
+
+double LoopShellMethod::control_energy(const Topology& topology, const Points& control, double kappa_b,
+                                       Points* gradient) const {
+  auto cache = cache_for(topology);
+  return loop_shell::shell_energy(cache->patches, cache->bases, control, kappa_b, gradient);
+}
+
+LoopShellState LoopShellMethod::state(const Topology& topology, const Points& x, double kappa_b) const {
+  auto cache = cache_for(topology);
+  LoopShellState s;
+  s.control = control_points(topology, x);
+  Points gradient;
+  SparseMatrix m = cache->mass.pattern();
+  s.energy = loop_shell::shell_energy_mass(cache->patches, cache->bases, cache->mass, cache->colouring, s.control,
+                                           kappa_b, gradient, m);
+  s.control_force = -gradient;
+  s.force_coefficients = solve_mass(*cache, m, Eigen::MatrixXd(s.control_force));
+  return s;
+}
+
+BendingResult LoopShellMethod::evaluate(const Topology& topology, const Points& x, double kappa_b,
+                                        bool nodal_geometry) const {
+  auto cache = cache_for(topology);
+  const int nv = topology.num_vertices();
+  BendingResult r;
+  const Points control = control_points(topology, x);
+  Points gradient;
+  const bool project_h = nodal_geometry && h_mode_ == HMode::Projection;
+  SparseMatrix m = cache->mass.pattern();
+  Eigen::VectorXd h_rhs;
+  r.energy = loop_shell::shell_energy_mass(cache->patches, cache->bases, cache->mass, cache->colouring, control,
+                                           kappa_b, gradient, m, project_h ? &h_rhs : nullptr);
+  Eigen::MatrixXd rhs(nv, project_h ? 4 : 3);
+  rhs.leftCols(3) = -gradient;
+  if (project_h) rhs.col(3) = h_rhs;
+  const Eigen::MatrixXd solution = solve_mass(*cache, m, rhs);
+  const Eigen::MatrixXd fc = solution.leftCols(3);
+  r.force_density = cache->limit * fc;
+  r.area = MeshGeometry::compute(topology, x).mixed_area;
+  r.force = r.force_density.array().colwise() * r.area.array();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  r.lapH = Scalars::Constant(nv, nan);
+  if (nodal_geometry) {
+    r.normal = loop_shell::limit_normals(topology, control);
+    loop_shell::limit_curvatures(topology, cache->patches, control, r.H, r.K);
+    if (project_h) r.H = cache->limit * solution.col(3);
+  } else {
+    r.normal = Points::Constant(nv, 3, nan);
+    r.H = r.K = Scalars::Constant(nv, nan);
+  }
+  return r;
+}
+
+Eigen::MatrixXd LoopShellMethod::solve_mass(Cache& cache, const SparseMatrix& m, const Eigen::MatrixXd& b) const {
+  if (solver_ == Solver::CG) {
+    Eigen::MatrixXd start;
+    {
+      std::lock_guard<std::mutex> lock(cache.mutex);
+      start = cache.last_solution;
+    }
+    Eigen::MatrixXd x = loop_shell::solve_mass_cg(m, b, kCgTolerance, 10000, nullptr, &start);
+    std::lock_guard<std::mutex> lock(cache.mutex);
+    cache.last_solution = x;
+    return x;
+  }
+  std::lock_guard<std::mutex> lock(cache.mutex);
+  cache.mass_ldlt.factorize(m);
+  if (cache.mass_ldlt.info() != Eigen::Success) throw Error("method S: the mass matrix is not positive definite");
+  return cache.mass_ldlt.solve(b);
+}
+
+BendingResult LoopShellMethod::compute(const Topology& topology, const Points& x, double kappa_b) const {
+  return evaluate(topology, x, kappa_b, true);
+}
+
+void LoopShellMethod::forces(const Topology& topology, const Points& x, double kappa_b, Points& force) const {
+  force = evaluate(topology, x, kappa_b, false).force;
+}
+
+std::optional<double> LoopShellMethod::energy(const Topology& topology, const Points& x, double kappa_b) const {
+  return control_energy(topology, control_points(topology, x), kappa_b);
+}
+
+}  // namespace bendlab

@@ -1,0 +1,149 @@
+#include "bendlab/bending/loop_shell_energy.hpp"
+
+#include <algorithm>
+
+namespace bendlab::loop_shell {
+
+namespace {
+
+// x, x_,v, x_,w, x_,vv, x_,vw, x_,ww at one point: rows of basis * P(idx).
+using Derivs = Eigen::Matrix<double, 6, 3>;
+
+Derivs derivatives(const PatchBasis& b, const Points& p, const int* idx) {
+  Derivs d = Derivs::Zero();
+  for (Eigen::Index i = 0; i < b.cols(); ++i) d.noalias() += b.col(i) * p.row(idx[i]);
+  return d;
+}
+
+// Everything the energy gradient needs at one point.
+struct Geometry {
+  Vec3 a[2], dual[2], n;
+  Vec3 xdd[3];         // x_,vv  x_,vw  x_,ww
+  double g[2][2];      // inverse metric a^ab
+  double bl[3];        // b_vv, b_vw, b_ww
+  double J, H, K;
+};
+
+Geometry geometry(const Derivs& d) {
+  Geometry s;
+  s.a[0] = d.row(kDv).transpose();
+  s.a[1] = d.row(kDw).transpose();
+  for (int k = 0; k < 3; ++k) s.xdd[k] = d.row(kDvv + k).transpose();
+  const Vec3 c = s.a[0].cross(s.a[1]);
+  s.J = c.norm();
+  s.n = c / s.J;
+  const double g11 = s.a[0].dot(s.a[0]), g12 = s.a[0].dot(s.a[1]), g22 = s.a[1].dot(s.a[1]);
+  const double det = g11 * g22 - g12 * g12;
+  s.g[0][0] = g22 / det;
+  s.g[0][1] = s.g[1][0] = -g12 / det;
+  s.g[1][1] = g11 / det;
+  for (int k = 0; k < 2; ++k) s.dual[k] = s.g[k][0] * s.a[0] + s.g[k][1] * s.a[1];
+  for (int k = 0; k < 3; ++k) s.bl[k] = s.n.dot(s.xdd[k]);
+  s.H = -0.5 * (s.g[0][0] * s.bl[0] + 2.0 * s.g[0][1] * s.bl[1] + s.g[1][1] * s.bl[2]);
+  s.K = (s.bl[0] * s.bl[2] - s.bl[1] * s.bl[1]) / det;
+  return s;
+}
+
+}  // namespace
+
+QuadratureBases::QuadratureBases(TriangleRule rule, const std::vector<int>& valences) : rule_(std::move(rule)) {
+  for (int n : valences) {
+    if (n >= static_cast<int>(by_valence_.size())) by_valence_.resize(n + 1);
+    if (!by_valence_[n].empty()) continue;
+    for (int q = 0; q < rule_.size(); ++q) by_valence_[n].push_back(patch_basis(n, rule_.v[q], rule_.w[q]));
+  }
+}
+
+const std::vector<PatchBasis>& QuadratureBases::at(int valence) const {
+  if (valence < 0 || valence >= static_cast<int>(by_valence_.size()) || by_valence_[valence].empty())
+    throw Error("method S: no quadrature basis for valence " + std::to_string(valence));
+  return by_valence_[valence];
+}
+
+SurfacePoint surface_point(const PatchBasis& basis, const Points& control, const int* idx) {
+  const Derivs d = derivatives(basis, control, idx);
+  const Geometry g = geometry(d);
+  SurfacePoint s;
+  s.x = d.row(kValue).transpose();
+  s.a1 = g.a[0];
+  s.a2 = g.a[1];
+  s.n = g.n;
+  s.J = g.J;
+  s.H = g.H;
+  s.K = g.K;
+  return s;
+}
+
+double face_energy(const std::vector<PatchBasis>& basis, const TriangleRule& rule, const Points& control,
+                   const int* idx, double kappa_b, FaceLocal* local) {
+  const int m = static_cast<int>(basis.front().cols());
+  if (local) {
+    local->gradient.setZero(m, 3);
+    if (local->with_mass) local->mass.setZero(m, m);
+    if (local->with_h) local->h.setZero(m);
+  }
+  double energy = 0.0;
+  for (int q = 0; q < rule.size(); ++q) {
+    const Geometry s = geometry(derivatives(basis[q], control, idx));
+    const double wq = 0.5 * rule.weight[q] * 2.0 * kappa_b;  // 2 kB w_q
+    energy += wq * s.H * s.H * s.J;
+    if (!local) continue;
+    if (local->with_mass || local->with_h) {
+      const double wj = 0.5 * rule.weight[q] * s.J;
+      const auto n = basis[q].row(kValue);
+      if (local->with_mass) local->mass.noalias() += (wj * n.transpose()) * n;
+      if (local->with_h) local->h.noalias() += (wj * s.H) * n.transpose();
+    }
+    // b^ab = a^ag b_gd a^db and m_b = b^ab a_a; c^g = a^ab Gamma^g_ab.
+    const double bl[2][2] = {{s.bl[0], s.bl[1]}, {s.bl[1], s.bl[2]}};
+    double bu[2][2] = {};
+    for (int i = 0; i < 2; ++i)
+      for (int j = 0; j < 2; ++j)
+        for (int k = 0; k < 2; ++k)
+          for (int l = 0; l < 2; ++l) bu[i][j] += s.g[i][k] * bl[k][l] * s.g[l][j];
+    const Vec3 xab = s.g[0][0] * s.xdd[0] + 2.0 * s.g[0][1] * s.xdd[1] + s.g[1][1] * s.xdd[2];  // a^ab x_,ab
+    const double c1 = s.dual[0].dot(xab), c2 = s.dual[1].dot(xab);
+    const double hj = wq * s.H * s.J, h2j = wq * s.H * s.H * s.J;
+    // Coefficients of N_I,v .. N_I,ww in dE/dP_I (see the header).
+    Derivs qm;
+    qm.row(kValue).setZero();
+    for (int b = 0; b < 2; ++b) {
+      const Vec3 mb = bu[0][b] * s.a[0] + bu[1][b] * s.a[1];
+      const double cb = b == 0 ? c1 : c2;
+      qm.row(kDv + b) = (2.0 * hj * mb + h2j * s.dual[b] + hj * cb * s.n).transpose();
+    }
+    qm.row(kDvv) = (-hj * s.g[0][0] * s.n).transpose();
+    qm.row(kDvw) = (-hj * 2.0 * s.g[0][1] * s.n).transpose();
+    qm.row(kDww) = (-hj * s.g[1][1] * s.n).transpose();
+    local->gradient.noalias() += basis[q].transpose() * qm;
+  }
+  return energy;
+}
+
+double shell_energy(const LoopPatches& patches, const QuadratureBases& bases, const Points& control,
+                    double kappa_b, Points* gradient) {
+  if (gradient) gradient->setZero(control.rows(), 3);
+  double energy = 0.0;
+  FaceLocal local;
+  for (int f = 0; f < patches.num_faces(); ++f) {
+    const int* idx = patches.face_points(f);
+    energy += face_energy(bases.at(patches.valence[f]), bases.rule(), control, idx, kappa_b,
+                          gradient ? &local : nullptr);
+    if (gradient)
+      for (int i = 0; i < local.gradient.rows(); ++i) gradient->row(idx[i]) += local.gradient.row(i);
+  }
+  return energy;
+}
+
+double shell_area(const LoopPatches& patches, const QuadratureBases& bases, const Points& control) {
+  const TriangleRule& rule = bases.rule();
+  double area = 0.0;
+  for (int f = 0; f < patches.num_faces(); ++f) {
+    const auto& basis = bases.at(patches.valence[f]);
+    for (int q = 0; q < rule.size(); ++q)
+      area += 0.5 * rule.weight[q] * surface_point(basis[q], control, patches.face_points(f)).J;
+  }
+  return area;
+}
+
+}  // namespace bendlab::loop_shell

@@ -1,0 +1,70 @@
+#include "bendlab/bending/loop_shell_solve.hpp"
+
+#include <string>
+
+#include "bendlab/core/types.hpp"
+
+namespace bendlab::loop_shell {
+
+namespace {
+
+// q = M p for symmetric column-major M: row i of M is its column i.
+void symmetric_product(const Eigen::SparseMatrix<double>& m, const Eigen::MatrixXd& p, Eigen::MatrixXd& q) {
+  const int n = static_cast<int>(m.cols());
+  const int k = static_cast<int>(p.cols());
+  const int* outer = m.outerIndexPtr();
+  const int* inner = m.innerIndexPtr();
+  const double* values = m.valuePtr();
+#pragma omp parallel for schedule(static) if (n > 2000)
+  for (int i = 0; i < n; ++i)
+    for (int c = 0; c < k; ++c) {
+      double s = 0.0;
+      for (int e = outer[i]; e < outer[i + 1]; ++e) s += values[e] * p(inner[e], c);
+      q(i, c) = s;
+    }
+}
+
+}  // namespace
+
+Eigen::MatrixXd solve_mass_cg(const Eigen::SparseMatrix<double>& m, const Eigen::MatrixXd& b, double tolerance,
+                              int max_iterations, int* iterations, const Eigen::MatrixXd* x0) {
+  const Eigen::Index n = b.rows(), k = b.cols();
+  const Eigen::VectorXd inv_diag = m.diagonal().cwiseInverse();
+  const bool warm = x0 && x0->rows() == n && x0->cols() == k;
+  Eigen::MatrixXd x = warm ? *x0 : Eigen::MatrixXd::Zero(n, k), r = b;
+  if (warm) {
+    Eigen::MatrixXd mx(n, k);
+    symmetric_product(m, x, mx);
+    r -= mx;
+  }
+  Eigen::MatrixXd z = inv_diag.asDiagonal() * r, p = z, q(n, k);
+  Eigen::RowVectorXd rz = (r.cwiseProduct(z)).colwise().sum();
+  const Eigen::RowVectorXd limit = tolerance * b.colwise().norm();
+  int it = 0;
+  while (true) {
+    const Eigen::RowVectorXd res = r.colwise().norm();
+    if ((res.array() <= limit.array()).all()) break;
+    if (it == max_iterations)
+      throw Error("method S: the mass-matrix solve did not converge in " + std::to_string(max_iterations) +
+                  " CG iterations");
+    ++it;
+    symmetric_product(m, p, q);
+    for (Eigen::Index c = 0; c < k; ++c) {
+      if (res[c] <= limit[c]) continue;  // converged column: leave it
+      const double alpha = rz[c] / p.col(c).dot(q.col(c));
+      x.col(c) += alpha * p.col(c);
+      r.col(c) -= alpha * q.col(c);
+    }
+    z.noalias() = inv_diag.asDiagonal() * r;
+    for (Eigen::Index c = 0; c < k; ++c) {
+      const double rz_new = r.col(c).dot(z.col(c));
+      const double beta = rz[c] > 0 ? rz_new / rz[c] : 0.0;
+      p.col(c) = z.col(c) + beta * p.col(c);
+      rz[c] = rz_new;
+    }
+  }
+  if (iterations) *iterations = it;
+  return x;
+}
+
+}  // namespace bendlab::loop_shell

@@ -1,0 +1,124 @@
+// Method S: the fused, coloured, OpenMP assembly (loop_shell_assembly.hpp) against the serial
+// reference (shell_energy + MassPattern::assemble), thread-count independence, and the warm-started
+// mass solve.
+#include <gtest/gtest.h>
+#include <omp.h>
+
+#include <random>
+#include <set>
+
+#include "bendlab/bending/loop_shell.hpp"
+#include "bendlab/bending/loop_shell_assembly.hpp"
+#include "bendlab/bending/loop_shell_solve.hpp"
+#include "bendlab/mesh/generators.hpp"
+#include "bendlab/surfaces/analytic_surface.hpp"
+
+namespace bendlab {
+namespace {
+
+using namespace loop_shell;
+
+struct ShellSetup {
+  TriMesh mesh;
+  LoopPatches patches;
+  QuadratureBases bases;
+  MassPattern mass;
+  FaceColouring colouring;
+  Points control;
+  explicit ShellSetup(const TriMesh& m)
+      : mesh(m),
+        patches(LoopPatches::build(m.topology())),
+        bases(dunavant_rule(6), {4, 5, 6}),
+        mass(patches, m.num_vertices()),
+        colouring(FaceColouring::build(patches, m.num_vertices())) {
+    // An irregular shape: the RBC with a small deterministic perturbation.
+    control = make_rbc(1.0)->map_from_unit_sphere(m.positions());
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> u(-0.01, 0.01);
+    for (Eigen::Index i = 0; i < control.size(); ++i) control.data()[i] += u(rng);
+  }
+};
+
+TEST(LoopShellAssembly, ColoursSeparatePatchesAndCoverEveryFace) {
+  const ShellSetup s(sphere_mesh(MeshFamily::Octa, 2));
+  std::vector<int> seen(s.patches.num_faces(), 0);
+  for (int c = 0; c < s.colouring.num_colours(); ++c) {
+    std::set<int> points;
+    for (int k = s.colouring.offsets[c]; k < s.colouring.offsets[c + 1]; ++k) {
+      const int f = s.colouring.faces[k];
+      ++seen[f];
+      for (int a = 0; a < s.patches.valence[f] + 6; ++a)
+        EXPECT_TRUE(points.insert(s.patches.face_points(f)[a]).second) << "colour " << c << " face " << f;
+    }
+  }
+  for (int f = 0; f < s.patches.num_faces(); ++f) EXPECT_EQ(seen[f], 1) << f;
+}
+
+TEST(LoopShellAssembly, FusedAssemblyEqualsTheSerialReference) {
+  for (const TriMesh& mesh : {sphere_mesh(MeshFamily::MT1, 2), sphere_mesh(MeshFamily::Octa, 2)}) {
+    const ShellSetup s(mesh);
+    Points g_ref;
+    const double e_ref = shell_energy(s.patches, s.bases, s.control, 1.3, &g_ref);
+    Eigen::SparseMatrix<double> m_ref = s.mass.pattern();
+    Eigen::VectorXd h_ref;
+    s.mass.assemble(s.patches, s.bases, s.control, m_ref, &h_ref);
+
+    Points g;
+    Eigen::SparseMatrix<double> m = s.mass.pattern();
+    Eigen::VectorXd h;
+    // The serial pass (this size) and the coloured one on the threads (parallel_faces = 0).
+    for (const int parallel_faces : {kParallelFaces, 0}) {
+      const double e =
+          shell_energy_mass(s.patches, s.bases, s.mass, s.colouring, s.control, 1.3, g, m, &h, parallel_faces);
+      EXPECT_NEAR(e, e_ref, 1e-13 * e_ref);
+      EXPECT_LE((g - g_ref).cwiseAbs().maxCoeff(), 1e-12 * g_ref.cwiseAbs().maxCoeff());
+      EXPECT_LE(Eigen::MatrixXd(m - m_ref).cwiseAbs().maxCoeff(),
+                1e-14 * Eigen::MatrixXd(m_ref).cwiseAbs().maxCoeff());
+      EXPECT_LE((h - h_ref).cwiseAbs().maxCoeff(), 1e-14 * h_ref.cwiseAbs().maxCoeff());
+    }
+  }
+}
+
+TEST(LoopShellAssembly, GradientAndMassDoNotDependOnTheThreadCount) {
+  const ShellSetup s(sphere_mesh(MeshFamily::MT1, 2));
+  const int before = omp_get_max_threads();
+  Points g1, g2;
+  Eigen::SparseMatrix<double> m1 = s.mass.pattern(), m2 = s.mass.pattern();
+  omp_set_num_threads(1);
+  // parallel_faces = 0: the threads take part whatever the size.
+  const double e1 = shell_energy_mass(s.patches, s.bases, s.mass, s.colouring, s.control, 1.0, g1, m1, nullptr, 0);
+  omp_set_num_threads(2);
+  const double e2 = shell_energy_mass(s.patches, s.bases, s.mass, s.colouring, s.control, 1.0, g2, m2, nullptr, 0);
+  omp_set_num_threads(before);
+  EXPECT_NEAR(e1, e2, 1e-13 * e1);
+  EXPECT_EQ(g1, g2);
+  EXPECT_EQ(Eigen::MatrixXd(m1), Eigen::MatrixXd(m2));
+}
+
+TEST(LoopShellAssembly, WarmStartedSolveMeetsTheSameTolerance) {
+  const ShellSetup s(sphere_mesh(MeshFamily::MT1, 2));
+  Points g;
+  Eigen::SparseMatrix<double> m = s.mass.pattern();
+  shell_energy_mass(s.patches, s.bases, s.mass, s.colouring, s.control, 1.0, g, m);
+  int cold = 0, warm = 0;
+  const Eigen::MatrixXd x = solve_mass_cg(m, g, 1e-10, 1000, &cold);
+  // A nearby right-hand side from the previous solution: fewer iterations, same residual bound.
+  const Eigen::MatrixXd b = 1.001 * Eigen::MatrixXd(g);
+  const Eigen::MatrixXd y = solve_mass_cg(m, b, 1e-10, 1000, &warm, &x);
+  EXPECT_LT(warm, cold);
+  for (int c = 0; c < 3; ++c) EXPECT_LE((b.col(c) - m * y.col(c)).norm(), 1e-10 * b.col(c).norm());
+}
+
+TEST(LoopShellAssembly, RepeatedForcesOnOneTopologyAgree) {
+  // The second evaluation is warm-started; both meet the CG tolerance, so they agree closely.
+  const TriMesh mesh = sphere_mesh(MeshFamily::MT1, 2);
+  const Points x = make_rbc(1.0)->map_from_unit_sphere(mesh.positions());
+  const auto method = LoopShellMethod::create({});
+  Points f1, f2;
+  method->forces(mesh.topology(), x, 1.0, f1);
+  method->forces(mesh.topology(), x, 1.0, f2);
+  EXPECT_LE((f1 - f2).cwiseAbs().maxCoeff(), 1e-8 * f1.cwiseAbs().maxCoeff());
+}
+
+}  // namespace
+}  // namespace bendlab
