@@ -123,7 +123,7 @@ void run_shear(const ShearArgs& a) {
   mp.bending = bending;
   auto membrane = std::make_shared<const MembraneModel>(mesh, mp);
   std::unique_ptr<CapsuleSolver> solver;
-  nlohmann::json lattice_arguments, summary_fields = {{"rtol", a.rtol}, {"atol", a.atol}};
+  nlohmann::json lattice_arguments = nlohmann::json::object(), summary_fields = {{"rtol", a.rtol}, {"atol", a.atol}};
   double lattice_nodes = 0, lattice_gamma = 0;
   if (a.solver == "bim") {
     auto membrane = std::make_shared<const MembraneModel>(mesh, mp);
