@@ -282,7 +282,9 @@ TEST_F(Cli, ShearLbmWritesTheFilesOfABimRun) {
   const auto a = nlohmann::json::parse(slurp(bim / "summary.json"));
   const auto b = nlohmann::json::parse(slurp(lbm / "summary.json"));
   for (const auto& [key, value] : a.items())
-    if (key != "rtol" && key != "atol") EXPECT_TRUE(b.contains(key)) << key;
+    if (key != "rtol" && key != "atol") {
+      EXPECT_TRUE(b.contains(key)) << key;
+    }
   EXPECT_EQ(b["solver"], "lbm");
   EXPECT_EQ(b["lattice"]["nodes"], nlohmann::json({10, 10, 12}));
   // Rows every 0.005 in gamma t (rounded to whole lattice steps) up to t_end = 0.02.

@@ -64,8 +64,9 @@ TEST_F(LbmCapsule, UnitsAndSampling) {
   // The run's positions are the lattice ones over R, centred on the box centre.
   EXPECT_EQ((s.lattice_positions() / o.radius - s.positions()).cwiseAbs().maxCoeff(), 0.0);
   EXPECT_LT(s.positions().colwise().mean().norm(), 1e-12);
-  // kS = 1/G maps to the lattice's mu gamma R / G.
-  EXPECT_NEAR(s.force_scale() * s.membrane().kS(), o.lattice.kS, 1e-15);
+  // kS = 1/G maps to the lattice's mu gamma R / G: a force kS L of the run's units (L in R) is the
+  // lattice's kS_lattice (R L).
+  EXPECT_NEAR(s.force_scale() * s.membrane().kS(), o.lattice.kS * o.radius, 1e-15);
   EXPECT_EQ(s.sample_steps(), std::llround(0.01 / o.lattice.shear_rate));
   std::vector<double> times, dts;
   s.advance(0.05, [&](const AcceptedStep& a) {
