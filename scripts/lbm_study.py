@@ -19,9 +19,10 @@ same G, kappa_b_hat, method and 1280 triangles in --bim-work (default results/sh
 folder of scripts/shear_study.py); missing BIM runs are run there with scripts/shear_study.py's
 naming, so the two studies share them.
 
-Cost: before the runs, each radius is timed for --measure-steps lattice steps (default 300; the
-result is cached in <work>/cost.json), and the script prints the measured seconds per step and the
-projected wall time of every run and of the whole study. --only-measure stops there. Runs are
+Cost: before the runs, the two smallest radii are timed for --measure-steps lattice steps (default
+300; cached in <work>/cost.json, with the load average before and after), larger lattices are
+scaled from the largest measured one by node count (the fluid dominates), and the script prints
+the seconds per step and the projected wall time of every run and of the whole study. --only-measure stops there. Runs are
 cached and resumable as in scripts/shear_study.py: a run whose summary.json matches is not run
 again, an interrupted run continues from its checkpoint (--resume). --no-runs writes the document
 from what is in the work folder (finished runs; running or missing ones are listed as such).
@@ -203,9 +204,10 @@ def measure_cost(runs, work, bendlab, steps):
         folder.mkdir(parents=True)
         t_end = steps * probe.shear_rate()
         load = load_average()
-        start = time.monotonic()
+        start, cpu0 = time.monotonic(), os.times()
         rc = launch([str(bendlab)] + probe.arguments(folder, t_end=t_end), folder, False)
-        wall = time.monotonic() - start
+        wall, cpu1 = time.monotonic() - start, os.times()
+        cpu = (cpu1.children_user - cpu0.children_user) + (cpu1.children_system - cpu0.children_system)
         s = read_json(folder / "summary.json")
         if rc != 0 or s is None:
             print(f"cost probe {key} failed (exit {rc}); see {folder / 'run.log'}", file=sys.stderr)
@@ -215,6 +217,9 @@ def measure_cost(runs, work, bendlab, steps):
                       "nodes": s["lattice"]["nodes"], "steps": steps, "lattice_steps": n,
                       "run_seconds": s["wall_seconds"], "process_seconds": wall,
                       "seconds_per_step": s["wall_seconds"] / n,
+                      # CPU time of the whole process (setup included) per step: what the step costs
+                      # on a machine that is not shared, per thread-second
+                      "cpu_seconds_per_step": cpu / n,
                       "mlups": math.prod(s["lattice"]["nodes"]) * n / s["wall_seconds"] / 1e6,
                       "load_average_before": load, "load_average_after": load_average(),
                       "omp_threads": os.environ.get("OMP_NUM_THREADS", "default")}
@@ -226,14 +231,15 @@ def cost_key(run):
     return f"R{fmt_g(run.radius)}_mt1-{run.triangles}_box{'x'.join(fmt_g(b) for b in run.box)}"
 
 
-def seconds_per_step(run, cost):
+def seconds_per_step(run, cost, key="seconds_per_step"):
     """Measured, else scaled by node count from the largest measured case (the fluid dominates)."""
-    if cost_key(run) in cost:
-        return cost[cost_key(run)]["seconds_per_step"], "measured"
+    if cost_key(run) in cost and key in cost[cost_key(run)]:
+        return cost[cost_key(run)][key], "measured"
+    cost = {k: c for k, c in cost.items() if key in c}
     if not cost:
         return None, "no measurement"
     ref = max(cost.values(), key=lambda c: math.prod(c["nodes"]))
-    return ref["seconds_per_step"] * math.prod(run.nodes()) / math.prod(ref["nodes"]), \
+    return ref[key] * math.prod(run.nodes()) / math.prod(ref["nodes"]), \
         f"scaled from R = {fmt_g(ref['radius'])} by node count"
 
 
@@ -306,26 +312,32 @@ def main():
     # Cost per step, one probe per distinct lattice (the fluid dominates; method A's forces stand in).
     probes = {}
     for r in runs:
-        if r.method == "A" and cost_key(r) not in probes and (r.radius in radii[:2] or a.only_measure):
+        if r.method == "A" and cost_key(r) not in probes and r.radius in radii[:2]:
             probes[cost_key(r)] = r
     cost = read_json(work / "cost.json") or {}
     if not a.no_runs:
         cost = measure_cost(list(probes.values()), work, bendlab, a.measure_steps)
-    total = 0.0
+    total = total_cpu = 0.0
     projected = {}
     print(f"load average now: {' '.join(load_average())}")
     for r in runs:
         sps, how = seconds_per_step(r, cost)
         done = finished_summary(work / r.name, r) is not None
         projected[r] = (sps * r.steps() if sps else None, how)
+        cps, _ = seconds_per_step(r, cost, "cpu_seconds_per_step")
+        projected[r] = projected[r] + (cps * r.steps() if cps else None,)
         if sps and not done:
             total += sps * r.steps()
+        if cps and not done:
+            total_cpu += cps * r.steps()
     for k, c in sorted(cost.items()):
         print(f"cost {k}: {c['seconds_per_step'] * 1e3:.2f} ms per step ({c['mlups']:.1f} MLUPS, "
               f"{c['lattice_steps']} steps, load {' '.join(c['load_average_before'])})")
-    print(f"projected wall time of the LBM runs still to do, one at a time: {total / 3600:.1f} h")
+    print(f"projected wall time of the LBM runs still to do, one at a time, at the measured load: {total / 3600:.1f} h")
+    print(f"projected CPU time of the same runs (a machine to themselves, one thread each): {total_cpu / 3600:.1f} h")
+    totals = (total, total_cpu)
     if a.only_measure:
-        write_doc(a, runs, bim_runs, work, bim_work, cost, projected, total)
+        write_doc(a, runs, bim_runs, work, bim_work, cost, projected, totals)
         return
 
     if not a.no_runs:
@@ -334,10 +346,11 @@ def main():
         if not a.no_bim:
             for b in bim_runs:
                 execute(b, bim_work / b.name, bendlab)
-    write_doc(a, runs, bim_runs, work, bim_work, cost, projected, total)
+    write_doc(a, runs, bim_runs, work, bim_work, cost, projected, totals)
 
 
-def write_doc(a, runs, bim_runs, work, bim_work, cost, projected, total):
+def write_doc(a, runs, bim_runs, work, bim_work, cost, projected, totals):
+    total, total_cpu = totals
     doc = Path(a.doc)
     figdir = doc.parent / "lbm"
     figdir.mkdir(parents=True, exist_ok=True)
@@ -349,14 +362,23 @@ def write_doc(a, runs, bim_runs, work, bim_work, cost, projected, total):
          f"box {' x '.join(fmt_g(b) for b in BOX)} R (walls at z = +-{fmt_g(BOX[2] / 2)} R), phi2 kernel, ESPResSo's",
          "volume force with kappa_V = 100 kappa_S, 1280 triangles (MT1), gamma t = "
          f"{fmt_g(a.t_end)}, steady D over the last half. D(R) = D_inf + a / R^p through the radii.", ""]
+    finished = sum(finished_summary(work / r.name, r) is not None for r in runs)
+    L += [f"**Finished LBM runs: {finished} of {len(runs)}.** Unfinished runs appear below with their status",
+          "(not run, or started with the gamma t of their last checkpoint) and their projected time.", ""]
     # Cost
     L += ["## Cost per step and projected time", "",
-          "| lattice | nodes | seconds per step | MLUPS | load average before | measured with |", "|---|---|---|---|---|---|"]
+          "Each lattice was timed by a short run (`--measure-steps` lattice steps, setup included) on the",
+          "machine the script ran on, with the load average (all processes, 2 cores) noted: wall time under",
+          "that load, and the process's CPU time, which is closer to what the step costs on a machine that",
+          "is not shared.", "",
+          "| lattice | nodes | wall seconds per step | CPU seconds per step | MLUPS (wall) | load average before | measured with |",
+          "|---|---|---|---|---|---|---|"]
     for k, c in sorted(cost.items()):
-        L.append(f"| {k} | {'x'.join(str(n) for n in c['nodes'])} | {c['seconds_per_step']:.4f} | {c['mlups']:.1f} | "
+        cpu = f"{c['cpu_seconds_per_step']:.4f}" if "cpu_seconds_per_step" in c else "-"
+        L.append(f"| {k} | {'x'.join(str(n) for n in c['nodes'])} | {c['seconds_per_step']:.4f} | {cpu} | {c['mlups']:.1f} | "
                  f"{' '.join(c['load_average_before'])} | {c['lattice_steps']} steps, OMP_NUM_THREADS={c['omp_threads']} |")
     if not cost:
-        L.append("| (not measured yet) | | | | | |")
+        L.append("| (not measured yet) | | | | | | |")
     L += ["", "| run | lattice steps | status | wall time |", "|---|---|---|---|"]
     for r in runs:
         folder = work / r.name
@@ -366,11 +388,13 @@ def write_doc(a, runs, bim_runs, work, bim_work, cost, projected, total):
         else:
             cp = read_json(folder / "checkpoint.json")
             status = f"started, checkpoint at gamma t = {cp['time']:.2f}" if cp else "not run"
-            sec, how = projected[r]
-            wall = f"projected {sec / 3600:.2f} h ({how})" if sec else "not projected"
+            sec, how, cpu = projected[r]
+            wall = (f"projected {sec / 3600:.2f} h wall, {cpu / 3600:.2f} h CPU ({how})" if sec and cpu else
+                    f"projected {sec / 3600:.2f} h wall ({how})" if sec else "not projected")
         L.append(f"| {r.label()} ({r.triangles} triangles) | {r.steps()} | {status} | {wall} |")
-    L += ["", f"Projected wall time of the unfinished LBM runs, one after another on this machine: "
-              f"**{total / 3600:.1f} h**.", ""]
+    L += ["", f"Projected time of the unfinished LBM runs, one after another: **{total / 3600:.1f} h** of wall time "
+              f"at the measured load, **{total_cpu / 3600:.1f} h** of CPU time. Larger lattices are scaled from the",
+          "largest measured one by node count.", ""]
     # Results
     L += ["## Steady deformation", "",
           "| G | kB_hat | method | " + " | ".join(f"D (R = {fmt_g(R)})" for R in sorted({r.radius for r in runs}))
