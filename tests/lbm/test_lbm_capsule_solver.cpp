@@ -178,8 +178,8 @@ TEST_F(LbmCapsule, BlowUpNamesTheStepAndKeepsTheLastCheckpoint) {
     FAIL() << "no blow-up";
   } catch (const Error& e) {
     const std::string m = e.what();
-    EXPECT_NE(m.find("step"), std::string::npos) << m;
-    EXPECT_TRUE(m.find("node") != std::string::npos || m.find("not positive") != std::string::npos) << m;
+    EXPECT_NE(m.find("step "), std::string::npos) << m;
+    EXPECT_NE(m.find("node"), std::string::npos) << m;
   }
   const CapsuleCheckpoint c = CapsuleCheckpoint::read(o.folder / "checkpoint.json", s.membrane().num_vertices());
   EXPECT_TRUE(c.positions.allFinite());

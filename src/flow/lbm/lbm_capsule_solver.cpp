@@ -49,9 +49,15 @@ void LbmCapsuleSolver::step() {
     throw Error(fmt::format("LBM step {}: {}", n, e.what()));
   }
   ++counters_.velocity_evaluations;
-  for (Eigen::Index k = 0; k < X_.rows(); ++k)
+  const double reach = 0.5 * lattice_.nz() - lbm::ib_kernel_half_width(options_.kernel);
+  for (Eigen::Index k = 0; k < X_.rows(); ++k) {
     if (!std::isfinite(X_(k, 0)) || !std::isfinite(X_(k, 1)) || !std::isfinite(X_(k, 2)))
       throw Error(fmt::format("LBM blew up at step {}: membrane node {} has a non-finite position", n, k));
+    if (std::abs(X_(k, 2)) > reach)
+      throw Error(fmt::format("LBM step {}: membrane node {} at z = {:.4g} dx is within the kernel's reach of a wall "
+                              "(walls at z = +-{})",
+                              n, k, X_(k, 2), 0.5 * lattice_.nz()));
+  }
   x_ = X_ / options_.radius;
   if (n - last_fluid_check_ >= kFluidCheckSteps) {
     check_fluid();

@@ -20,9 +20,10 @@
 // reported steps.
 //
 // Blow-up. Node positions are checked after every step and the whole fluid (find_blow_up) every
-// kFluidCheckSteps steps and before every save_state: a non-finite node position, or a non-finite
-// or non-positive density, throws bendlab::Error naming the lattice step and the node, before the
-// step is reported, so the run's last checkpoint stays the last good state.
+// kFluidCheckSteps steps and before every save_state: a non-finite node position, a node whose
+// kernel reaches a wall, or a non-finite or non-positive density throws bendlab::Error naming the
+// lattice step and the membrane node or lattice node, before the step is reported, so the run's
+// last checkpoint stays the last good state.
 //
 // Checkpoint state: {"fluid": "lbm_fluid_<tag>.bin" (lbm/checkpoint.hpp, written atomically),
 // "lattice_step": n, "positions_lattice": [3N numbers, X in dx]} so that a resumed run repeats
