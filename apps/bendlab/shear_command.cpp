@@ -1,5 +1,6 @@
 // bendlab shear: an initially spherical capsule (neo-Hookean membrane + bending) in linear shear
-// flow, boundary integral method (paper section 4). Argument parsing only: the run is
+// flow, by the boundary integral method (paper section 4, --solver bim) or the immersed-boundary
+// lattice Boltzmann method (section 4.3.2, --solver lbm). Argument parsing only: the run is
 // run_shear (bendlab/flow/shear_run.hpp), whose folder (timeseries.csv, snapshots,
 // checkpoint.json, summary.json) belongs to run_capsule (bendlab/capsule/capsule_run.hpp).
 // D_theta.png is drawn by scripts/plot_shear.py, found at run time.
@@ -27,6 +28,9 @@ struct ShearArgs {
   int rings = 0;
   std::int64_t stop_after_steps = 0;
   bool resume = false, plot = true;
+  LatticeRunSpec lattice;  // --solver lbm
+  // Which options the user gave (the other solver's options are refused).
+  bool given_tolerance = false, given_lattice = false;
 };
 
 /// D_theta.png from scripts/plot_shear.py (--plot-script, else found at run time: an install's
@@ -44,7 +48,12 @@ void plot(const ShearArgs& a) {
 }
 
 void shear(const ShearArgs& a) {
+  if (a.solver == "lbm" && a.given_tolerance)
+    throw Error("--rtol and --atol are for --solver bim: the lattice Boltzmann solver takes fixed steps");
+  if (a.solver == "bim" && a.given_lattice)
+    throw Error("--radius-lu, --box, --tau, --reynolds, --kernel and --sample-every are for --solver lbm");
   ShearRunSpec spec;
+  spec.lattice = a.lattice;
   spec.folder = a.out;
   spec.solver = a.solver;
   spec.method = a.method;
@@ -65,7 +74,8 @@ void shear(const ShearArgs& a) {
     note(fmt::format("gamma t = {:7.4f} / {:g} ({:3.0f}%)  steps {:6d}  gamma dt {:.2e}  D {:.5f}  theta {:.4f}  "
                      "elapsed {:.0f} s  ETA {:.0f} s",
                      p.time, p.t_end, 100 * (p.time - p.t_start) / (p.t_end - p.t_start), p.steps, p.dt, p.D,
-                     p.theta, p.elapsed_seconds, p.eta_seconds));
+                     p.theta, p.elapsed_seconds, p.eta_seconds) +
+         (p.mlups > 0 ? fmt::format("  {:.1f} MLUPS", p.mlups) : std::string()));
   };
   const CapsuleRunResult result = run_shear(spec, callbacks);
   if (!result.finished) {
@@ -80,8 +90,9 @@ const CommandRegistration registration([](CLI::App& app) {
   auto args = std::make_shared<ShearArgs>();
   auto* cmd = app.add_subcommand("shear", "Simulate an initially spherical capsule (neo-Hookean membrane plus "
                                           "bending) in linear shear flow u = gamma z e_x at zero Reynolds number");
-  cmd->add_option("--solver", args->solver, "flow solver: bim (boundary integral method)")
-      ->check(CLI::IsMember({"bim"}))->capture_default_str();
+  cmd->add_option("--solver", args->solver,
+                  "flow solver: bim (boundary integral method) or lbm (immersed-boundary lattice Boltzmann)")
+      ->check(CLI::IsMember({"bim", "lbm"}))->capture_default_str();
   cmd->add_option("--method", args->method, "bending method: none, " + method_names_joined())
       ->check(CLI::IsMember(method_choices_with_none()))->capture_default_str();
   cmd->add_option("--rings", args->rings, "fitting support of E and ED (1, 2, 3)")->check(CLI::Range(1, 3));
@@ -96,12 +107,27 @@ const CommandRegistration registration([](CLI::App& app) {
                               "dimensional bending modulus kB = kappa_b_hat / G (R = mu = gamma = 1)");
   hat->excludes(dim);
   cmd->add_option("--t-end", args->t_end, "end of the run in gamma t")->capture_default_str();
-  cmd->add_option("--rtol", args->rtol,
-                  "relative tolerance of the Cash-Karp stepper; above 1e-2 refused, above 1e-4 warned (less "
-                  "accurate D, theta)")->capture_default_str();
-  cmd->add_option("--atol", args->atol,
-                  "absolute tolerance of the Cash-Karp stepper, in units of R; above 1e-2 refused, above 1e-4 warned")
-      ->capture_default_str();
+  auto tolerance = [args](const std::string&) { args->given_tolerance = true; };
+  auto lattice = [args](const std::string&) { args->given_lattice = true; };
+  cmd->add_option("--rtol", args->rtol, "relative tolerance of the Cash-Karp stepper (bim); above 1e-2 refused, "
+                  "above 1e-4 warned (less accurate D, theta)")->capture_default_str()->each(tolerance);
+  cmd->add_option("--atol", args->atol, "absolute tolerance of the Cash-Karp stepper, in units of R (bim); above "
+                  "1e-2 refused, above 1e-4 warned")->capture_default_str()->each(tolerance);
+  cmd->add_option("--radius-lu", args->lattice.radius_lu, "capsule radius R in lattice units (lbm)")
+      ->capture_default_str()->each(lattice);
+  cmd->add_option("--box", args->lattice.box, "box edges in multiples of R: x,y,z (z: wall distance; lbm)")
+      ->delimiter(',')->expected(3)->capture_default_str()->each(lattice);
+  cmd->add_option("--tau", args->lattice.tau, "LBM relaxation time, > 1/2 (viscosity (tau - 1/2)/3; lbm)")
+      ->capture_default_str()->each(lattice);
+  cmd->add_option("--reynolds", args->lattice.reynolds,
+                  "Reynolds number Re = R v / nu of the wall speed v, as in the paper (warns above its 0.3; "
+                  "particle Re = gamma R^2 / nu is in summary.json; lbm)")
+      ->capture_default_str()->each(lattice);
+  cmd->add_option("--kernel", args->lattice.kernel, "immersed-boundary kernel: phi2 (ESPResSo's), phi3, phi4 (lbm)")
+      ->check(CLI::IsMember({"phi2", "phi3", "phi4"}))->capture_default_str()->each(lattice);
+  cmd->add_option("--sample-every", args->lattice.sample_every,
+                  "gamma t between time-series rows, rounded to whole lattice steps (lbm)")
+      ->capture_default_str()->each(lattice);
   cmd->add_option("--snapshot-every", args->snapshot_every, "gamma t between .vtp snapshots and checkpoints")
       ->capture_default_str();
   cmd->add_flag("--resume", args->resume,

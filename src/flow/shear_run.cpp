@@ -8,6 +8,8 @@
 #include "bendlab/capsule/run_tolerances.hpp"
 #include "bendlab/capsule/shear_units.hpp"
 #include "bendlab/flow/bim/bim_capsule_solver.hpp"
+#include "bendlab/flow/lbm/lbm_capsule_solver.hpp"
+#include "bendlab/membrane/espresso_volume_force.hpp"
 #include "bendlab/integrate/cash_karp.hpp"
 #include "bendlab/mesh/mesh_spec.hpp"
 
@@ -32,7 +34,16 @@ std::string method_list() {
 
 CapsuleRunResult run_shear(const ShearRunSpec& a, const ShearRunCallbacks& callbacks) {
   // Everything is checked before any work starts.
-  if (a.solver != "bim") throw Error(fmt::format("--solver '{}': the flow solvers are: bim", a.solver));
+  if (a.solver != "bim" && a.solver != "lbm")
+    throw Error(fmt::format("--solver '{}': the flow solvers are: bim, lbm", a.solver));
+  if (a.solver == "lbm") {
+    require_positive("--radius-lu", a.lattice.radius_lu);
+    require_positive("--sample-every", a.lattice.sample_every);
+    if (a.lattice.box.size() != 3) throw Error("--box needs three multiples of R: x,y,z");
+    if (a.lattice.kernel != "phi2" && a.lattice.kernel != "phi3" && a.lattice.kernel != "phi4")
+      throw Error(fmt::format("--kernel '{}': the kernels are phi2, phi3, phi4", a.lattice.kernel));
+    // tau, Re, the box and the walls are checked by lbm::capsule_run_parameters below, before any work.
+  }
   require_positive("--G", a.G);
   if (a.kappa_b_hat) require_positive("--kappa-b-hat", *a.kappa_b_hat, true);
   if (a.kappa_b) require_positive("--kappa-b", *a.kappa_b, true);
@@ -64,14 +75,65 @@ CapsuleRunResult run_shear(const ShearRunSpec& a, const ShearRunCallbacks& callb
   mp.kS = units.kS();
   mp.kB = units.kB();
   mp.bending = bending;
-  auto membrane = std::make_shared<const MembraneModel>(mesh, mp);
-  CashKarpOptions ck;
-  ck.rtol = a.rtol;
-  ck.atol = a.atol;
-  BimOptions bim;
-  bim.mu = ShearUnits::mu;
-  bim.gamma = ShearUnits::gamma;
-  BimCapsuleSolver solver(membrane, std::make_unique<CashKarp>(ck), bim);
+  std::unique_ptr<CapsuleSolver> solver;
+  nlohmann::json lattice_arguments = nlohmann::json::object();
+  nlohmann::json summary_fields = {{"rtol", a.rtol}, {"atol", a.atol}};
+  double lattice_nodes = 0, lattice_gamma = 0;
+  if (a.solver == "bim") {
+    auto membrane = std::make_shared<const MembraneModel>(mesh, mp);
+    CashKarpOptions ck;
+    ck.rtol = a.rtol;
+    ck.atol = a.atol;
+    BimOptions bim;
+    bim.mu = ShearUnits::mu;
+    bim.gamma = ShearUnits::gamma;
+    solver = std::make_unique<BimCapsuleSolver>(membrane, std::make_unique<CashKarp>(ck), bim);
+  } else {
+    const LatticeRunSpec& l = a.lattice;
+    lbm::CapsuleRunInput in;
+    in.radius = l.radius_lu;
+    in.tau = l.tau;
+    in.box_x = l.box[0];
+    in.box_y = l.box[1];
+    in.box_z = l.box[2];
+    in.reynolds = l.reynolds;
+    in.G = units.G;
+    in.kB_hat = units.kappa_b_hat;
+    in.kV_over_kS = kEspressoVolumeRatio;
+    in.gamma_t_end = a.t_end;
+    in.kernel = l.kernel == "phi2" ? lbm::IbKernel::Phi2 : l.kernel == "phi3" ? lbm::IbKernel::Phi3 : lbm::IbKernel::Phi4;
+    const lbm::CapsuleRunParameters p = lbm::capsule_run_parameters(in);
+    if (callbacks.on_note)
+      for (const std::string& w : p.warnings) callbacks.on_note("warning: " + w);
+    mp.volume_force = std::make_shared<const EspressoVolumeForce>(EspressoVolumeForce::for_membrane(mp.kS));
+    auto membrane = std::make_shared<const MembraneModel>(mesh, mp);
+    LbmSolverOptions lo;
+    lo.radius = l.radius_lu;
+    lo.lattice = p;
+    lo.kernel = in.kernel;
+    lo.sample_every = l.sample_every;
+    auto lbm_solver = std::make_unique<LbmCapsuleSolver>(membrane, lo);
+    const auto sample_steps = lbm_solver->sample_steps();
+    solver = std::move(lbm_solver);
+    lattice_nodes = static_cast<double>(p.nx) * p.ny * p.nz;
+    lattice_gamma = p.shear_rate;
+    lattice_arguments = {{"radius_lu", l.radius_lu}, {"box", l.box},      {"tau", l.tau},
+                         {"reynolds", l.reynolds},   {"kernel", l.kernel}, {"sample_every", l.sample_every},
+                         {"kappa_v_over_kappa_s", kEspressoVolumeRatio}};
+    summary_fields = {{"lattice",
+                       {{"nodes", {p.nx, p.ny, p.nz}},
+                        {"nu", p.nu},
+                        {"wall_velocity", p.wall_velocity},
+                        {"shear_rate", p.shear_rate},
+                        {"mach", p.mach},
+                        {"reynolds", p.reynolds},
+                        {"particle_reynolds", p.particle_reynolds},
+                        {"kS", p.kS},
+                        {"kB", p.kB},
+                        {"kV", p.kV},
+                        {"steps", p.steps},
+                        {"sample_steps", sample_steps}}}};
+  }
 
   CapsuleRunOptions o;
   o.folder = a.folder;
@@ -90,12 +152,20 @@ CapsuleRunResult run_shear(const ShearRunSpec& a, const ShearRunCallbacks& callb
                  {"kappa_b_hat", units.kappa_b_hat},
                  {"kappa_b", units.kappa_b()},
                  {"method_options", a.method_options}};
-  o.summary_fields = {{"rtol", a.rtol}, {"atol", a.atol}};
+  for (const auto& [key, value] : lattice_arguments.items()) o.arguments[key] = value;
+  o.summary_fields = summary_fields;
   o.on_note = callbacks.on_note;
-  o.on_progress = callbacks.on_progress;
+  if (callbacks.on_progress)
+    o.on_progress = [&](const CapsuleProgress& progress) {
+      CapsuleProgress p = progress;
+      // Lattice node updates per second of this part (fluid + membrane + IBM).
+      if (lattice_gamma > 0 && p.elapsed_seconds > 0)
+        p.mlups = (p.time - p.t_start) / lattice_gamma * lattice_nodes / p.elapsed_seconds / 1e6;
+      callbacks.on_progress(p);
+    };
   o.should_stop = callbacks.should_stop;
   o.progress_interval_seconds = callbacks.progress_interval_seconds;
-  return run_capsule(solver, o);
+  return run_capsule(*solver, o);
 }
 
 }  // namespace bendlab

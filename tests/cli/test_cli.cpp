@@ -304,6 +304,47 @@ TEST_F(Cli, ShearWritesItsFilesAndResumes) {
                  out / "nothing");
 }
 
+TEST_F(Cli, ShearLbmRefusesBadLatticesBeforeWork) {
+  const fs::path out = dir / "run";
+  const std::string lbm = "shear --solver lbm --mesh mt1:320 ";
+  expect_refused(run(lbm + "--tau 0.5 --out " + out.string()), "tau", out);
+  expect_refused(run(lbm + "--box 1.5,8,10 --out " + out.string()), "does not contain the capsule", out);
+  expect_refused(run(lbm + "--box 8,8,2 --out " + out.string()), "touches the walls", out);
+  expect_refused(run(lbm + "--reynolds 100 --out " + out.string()), "Mach", out);
+  expect_refused(run(lbm + "--radius-lu -3 --out " + out.string()), "--radius-lu", out);
+  expect_refused(run(lbm + "--box 8,8 --out " + out.string()), "--box", out);
+  expect_refused(run(lbm + "--kernel phi5 --out " + out.string()), "--kernel", out);
+  expect_refused(run(lbm + "--rtol 1e-6 --out " + out.string()), "--rtol", out);
+  expect_refused(run("shear --mesh mt1:320 --tau 1 --out " + out.string()), "--solver lbm", out);
+}
+
+TEST_F(Cli, ShearLbmWritesTheFilesOfABimRun) {
+  const fs::path bim = dir / "bim", lbm = dir / "lbm";
+  CliRun r = run("shear --mesh mt1:320 --G 0.1 --t-end 0.02 --snapshot-every 0.01 --no-plot --out " + bim.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  // R = 4 dx in a 10 x 10 x 12 box: a few dozen lattice steps.
+  r = run("shear --solver lbm --radius-lu 4 --box 2.5,2.5,3 --mesh mt1:320 --G 0.1 --t-end 0.02 "
+          "--snapshot-every 0.01 --sample-every 0.005 --no-plot --out " + lbm.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("MLUPS"), std::string::npos) << r.err;
+  for (const char* f : {"timeseries.csv", "summary.json", "shapes.pvd", "checkpoint.json", "snapshot_00000.vtp"})
+    EXPECT_TRUE(fs::exists(lbm / f)) << f;
+  const std::string header = "gamma_t,D,theta,volume,area,E_bend,E_elastic,dt\n";
+  EXPECT_EQ(slurp(bim / "timeseries.csv").rfind(header, 0), 0u);
+  EXPECT_EQ(slurp(lbm / "timeseries.csv").rfind(header, 0), 0u);
+  const auto a = nlohmann::json::parse(slurp(bim / "summary.json"));
+  const auto b = nlohmann::json::parse(slurp(lbm / "summary.json"));
+  for (const auto& [key, value] : a.items())
+    if (key != "rtol" && key != "atol") {
+      EXPECT_TRUE(b.contains(key)) << key;
+    }
+  EXPECT_EQ(b["solver"], "lbm");
+  EXPECT_EQ(b["lattice"]["nodes"], nlohmann::json({10, 10, 12}));
+  // Rows every 0.005 in gamma t (rounded to whole lattice steps) up to t_end = 0.02.
+  const auto checkpoint = nlohmann::json::parse(slurp(lbm / "checkpoint.json"));
+  EXPECT_TRUE(fs::exists(lbm / checkpoint["solver_state"]["fluid"].get<std::string>()));
+}
+
 TEST_F(Cli, ComparingWithASurfaceTheNodesAreNotOnIsRefused) {
   const fs::path sphere = dir / "sphere.off";
   ASSERT_EQ(run("mesh --family mt1 --level 2 --out " + sphere.string()).status, 0);

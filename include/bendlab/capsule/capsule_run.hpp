@@ -35,6 +35,7 @@ struct CapsuleProgress {
   double elapsed_seconds = 0;               ///< wall time of this part
   double eta_seconds = 0;                   ///< estimated wall time to t_end
   bool final = false;                       ///< the report at t_end
+  double mlups = 0;                         ///< lattice node updates per second (lattice solvers; else 0)
 };
 
 struct CapsuleRunOptions {

@@ -10,15 +10,27 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "bendlab/bending/bending_method.hpp"
 #include "bendlab/capsule/capsule_run.hpp"
 
 namespace bendlab {
 
+/// The lattice of --solver lbm (paper section 4.3.2, flow/lbm/parameters.hpp).
+struct LatticeRunSpec {
+  double radius_lu = 6;                ///< capsule radius R in lattice units
+  std::vector<double> box = {8, 8, 10};  ///< box edges in multiples of R (z: the wall distance)
+  double tau = 1;                      ///< relaxation time, > 1/2
+  double reynolds = 0.2;               ///< Re = R v / nu of the wall speed (the paper's; warned above 0.3)
+  std::string kernel = "phi2";         ///< immersed-boundary kernel: phi2, phi3, phi4
+  double sample_every = 1e-3;          ///< gamma t between time-series rows
+};
+
 struct ShearRunSpec {
   std::filesystem::path folder;        ///< run folder (created if missing)
-  std::string solver = "bim";          ///< flow solver: "bim"
+  std::string solver = "bim";          ///< flow solver: "bim" or "lbm"
+  LatticeRunSpec lattice;              ///< used by "lbm"
   std::string method = "none";         ///< bending method (registry name) or "none"
   MethodOptions method_options;        ///< options of the method, as on a command line
   std::string mesh = "mt1:1280";       ///< mesh_spec.hpp: mt1:N, mt2:N, octa:N, inh:mt1, inh:mt2 or a file
@@ -27,7 +39,7 @@ struct ShearRunSpec {
   std::optional<double> kappa_b;       ///< dimensional kB
   double t_end = 10;                   ///< gamma t
   double snapshot_every = 0.5;         ///< gamma t between snapshots and checkpoints
-  double rtol = 1e-7, atol = 1e-6;     ///< the adaptive integrator's tolerances (atol in units of R)
+  double rtol = 1e-7, atol = 1e-6;     ///< the BIM integrator's tolerances (atol in units of R)
   bool resume = false;                 ///< continue from folder/checkpoint.json
   std::int64_t stop_after_steps = 0;   ///< stop (resumable) after this many steps; 0: never
 };

@@ -1,8 +1,9 @@
 #pragma once
-// Hook for a force that acts on the enclosed volume, e.g. ESPResSo's volume penalty
-// E_V = kV (V - V0)^2 / (2 V0). The membrane model adds its forces to the elastic and bending
-// ones when one is given; bendlab ships no implementation yet (the BIM conserves the volume by
-// the zero-flux projection and rescaling instead, volume_correction.hpp).
+// Hook for a force that acts on the enclosed volume, e.g. ESPResSo's volume conservation
+// (espresso_volume_force.hpp). The membrane model adds its forces to the elastic and bending
+// ones when one is given. ESPResSo's form is espresso_volume_force.hpp (the LBM capsule solver's);
+// the BIM conserves the volume by the zero-flux projection and rescaling instead
+// (volume_correction.hpp).
 //
 // Implementations are immutable; their const methods must be safe to call concurrently.
 #include <optional>

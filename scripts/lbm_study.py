@@ -1,0 +1,454 @@
+#!/usr/bin/python3
+"""The paper's figure 15 (LBM beside BIM) from `bendlab shear --solver lbm` runs, with the
+resolution study of shared/spec/LBM_IBM.md section 5.
+
+    /usr/bin/python3 scripts/lbm_study.py [--radii 6,8,10] [--full] [--t-end T] [--jobs N]
+                                          [--measure-steps N] [--only-measure] [--no-runs]
+                                          [--bim-work DIR] [--work DIR] [--doc FILE] [--bendlab PATH]
+
+Cases: (G, kappa_b_hat) = (0.05, 0.0375) and (0.2, 0.15) with the paper's LBM methods A and B
+(figure 15), and kappa_b_hat = 0 at the same G, each at R = 6, 8, 10 lattice units (--radii), with
+the same box in multiples of R (8 x 8 x 10, walls 10 R apart), tau = 1, Re = R v / nu = 0.2
+(particle Re = gamma R^2 / nu = 0.04) and 1280 triangles. --full adds the paper's own size:
+R = 13.5, 5120 triangles, box 9.5 R x 9.5 R x 19 R (128 x 128 x 256 nodes).
+
+For each case the steady D (gamma t in [5, 10]) is fitted as D(R) = D_inf + a / R^p (three radii
+determine D_inf, a and p; with two only p = 1 is assumed), and the smallest R within 2 % of D_inf
+is named (the spec's protocol). The BIM values beside them are read from the BIM runs with the
+same G, kappa_b_hat, method and 1280 triangles in --bim-work (default results/shear_study, the
+folder of scripts/shear_study.py); missing BIM runs are run there with scripts/shear_study.py's
+naming, so the two studies share them.
+
+Cost: before the runs, the two smallest radii are timed for --measure-steps lattice steps (default
+300; cached in <work>/cost.json, with the load average before and after), larger lattices are
+scaled from the largest measured one by node count (the fluid dominates), and the script prints
+the seconds per step and the projected wall time of every run and of the whole study. --only-measure stops there. Runs are
+cached and resumable as in scripts/shear_study.py: a run whose summary.json matches is not run
+again, an interrupted run continues from its checkpoint (--resume). --no-runs writes the document
+from what is in the work folder (finished runs; running or missing ones are listed as such).
+
+Writes --doc (default docs/results/lbm.md) and its PNGs (docs/results/lbm/).
+"""
+import argparse
+import csv
+import json
+import math
+import os
+import shlex
+import shutil
+import subprocess
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+ROOT = Path(__file__).resolve().parent.parent
+PAIRS = [(0.05, 0.0375), (0.2, 0.15)]
+METHODS = ["A", "B"]  # the paper's LBM methods (figure 15)
+TAU, REYNOLDS = 1.0, 0.2
+BOX = (8.0, 8.0, 10.0)
+FULL_BOX = (9.5, 9.5, 19.0)
+FULL_R = 13.5
+
+
+def fmt_g(x):
+    return f"{x:g}"
+
+
+@dataclass(frozen=True)
+class LbmRun:
+    method: str
+    G: float
+    kappa_b: float
+    radius: float
+    triangles: int
+    box: tuple
+    t_end: float
+
+    @property
+    def name(self):
+        return (f"lbm_{self.method}_R{fmt_g(self.radius)}_mt1-{self.triangles}_G{fmt_g(self.G)}"
+                f"_kb{fmt_g(self.kappa_b)}_t{fmt_g(self.t_end)}")
+
+    def label(self):
+        return f"LBM method {self.method:>4}, R = {fmt_g(self.radius):>4}, G = {fmt_g(self.G)}, kB_hat = {fmt_g(self.kappa_b)}"
+
+    def nodes(self):
+        return [round(b * self.radius) for b in self.box]
+
+    def shear_rate(self):
+        """gamma in lattice units, as lbm::capsule_run_parameters computes it."""
+        nu = (TAU - 0.5) / 3
+        v = REYNOLDS * nu / self.radius
+        return 2 * v / self.nodes()[2]
+
+    def steps(self):
+        return math.ceil(self.t_end / self.shear_rate())
+
+    def arguments(self, out, t_end=None):
+        return ["shear", "--solver", "lbm", "--method", self.method, "--mesh", f"mt1:{self.triangles}",
+                "--G", fmt_g(self.G), "--kappa-b-hat", fmt_g(self.kappa_b),
+                "--radius-lu", fmt_g(self.radius), "--box", ",".join(fmt_g(b) for b in self.box),
+                "--tau", fmt_g(TAU), "--reynolds", fmt_g(REYNOLDS),
+                "--t-end", fmt_g(self.t_end if t_end is None else t_end), "--out", str(out), "--no-plot"]
+
+
+@dataclass(frozen=True)
+class BimRun:
+    """A BIM run named as scripts/shear_study.py names it (so both studies share it)."""
+    method: str
+    G: float
+    kappa_b: float
+    t_end: float
+    triangles: int = 1280
+
+    @property
+    def name(self):
+        return (f"{self.method}_mt1-{self.triangles}_G{fmt_g(self.G)}_kb{fmt_g(self.kappa_b)}"
+                f"_t{fmt_g(self.t_end)}")
+
+    def arguments(self, out):
+        return ["shear", "--method", self.method, "--mesh", f"mt1:{self.triangles}", "--G", fmt_g(self.G),
+                "--kappa-b-hat", fmt_g(self.kappa_b), "--t-end", fmt_g(self.t_end), "--out", str(out),
+                "--no-plot"]
+
+
+def close(a, b):
+    return a is not None and b is not None and abs(float(a) - float(b)) <= 1e-12 * max(1.0, abs(float(b)))
+
+
+def read_json(path):
+    try:
+        return json.loads(Path(path).read_text())
+    except (OSError, ValueError):
+        return None
+
+
+def lbm_matches(args, run):
+    try:
+        return (args.get("solver") == "lbm" and args.get("method") == run.method
+                and args.get("mesh") == f"mt1:{run.triangles}" and close(args.get("G"), run.G)
+                and close(args.get("kappa_b_hat"), run.kappa_b) and close(args.get("radius_lu"), run.radius)
+                and all(close(a, b) for a, b in zip(args.get("box", []), run.box)))
+    except (TypeError, ValueError, AttributeError):
+        return False
+
+
+def finished_summary(folder, run):
+    s = read_json(folder / "summary.json")
+    if s is not None and close(s.get("t_end"), run.t_end) and (
+            lbm_matches(s, run) if isinstance(run, LbmRun) else
+            (s.get("method") == run.method and close(s.get("G"), run.G) and close(s.get("kappa_b_hat"), run.kappa_b))):
+        return s
+    return None
+
+
+def launch(cmd, folder, resume):
+    cmd = cmd + (["--resume"] if resume else [])
+    with open(folder / "run.log", "a") as log:
+        log.write("$ " + shlex.join(cmd) + "\n")
+        log.flush()
+        return subprocess.run(cmd, stdout=log, stderr=log, cwd=ROOT).returncode
+
+
+def execute(run, folder, bendlab):
+    """Runs (or reuses, or resumes) one run; returns its summary or None."""
+    s = finished_summary(folder, run)
+    if s is not None:
+        print(f"cached   {folder.name}: D_steady {s['D_steady']:.4f}", flush=True)
+        return s
+    cp = read_json(folder / "checkpoint.json")
+    resume = cp is not None and (lbm_matches(cp.get("arguments", {}), run) if isinstance(run, LbmRun) else
+                                 cp.get("arguments", {}).get("method") == run.method)
+    if not resume and folder.exists():
+        shutil.rmtree(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    print(f"{'resume' if resume else 'start '}   {folder.name}", flush=True)
+    rc = launch([str(bendlab)] + run.arguments(folder), folder, resume)
+    if rc != 0 and resume:
+        shutil.rmtree(folder)
+        folder.mkdir(parents=True)
+        rc = launch([str(bendlab)] + run.arguments(folder), folder, False)
+    s = finished_summary(folder, run)
+    print(f"{'done    ' if s else 'FAILED  '} {folder.name}" + (f": D_steady {s['D_steady']:.4f}, "
+                                                             f"{s['wall_seconds']:.0f} s" if s else f" (exit {rc})"),
+          flush=True)
+    return s
+
+
+def load_average():
+    try:
+        return Path("/proc/loadavg").read_text().split()[:3]
+    except OSError:
+        return ["?"] * 3
+
+
+def measure_cost(runs, work, bendlab, steps):
+    """Seconds per lattice step (fluid + membrane + IBM + sampling) of each (R, triangles, box),
+    from a short run of `steps` steps; cached in work/cost.json."""
+    cache_path = work / "cost.json"
+    cache = read_json(cache_path) or {}
+    for run in runs:
+        key = f"R{fmt_g(run.radius)}_mt1-{run.triangles}_box{'x'.join(fmt_g(b) for b in run.box)}"
+        if key in cache and cache[key].get("steps") == steps:
+            continue
+        probe = LbmRun(run.method, run.G, run.kappa_b, run.radius, run.triangles, run.box, run.t_end)
+        folder = work / "cost" / key
+        shutil.rmtree(folder, ignore_errors=True)
+        folder.mkdir(parents=True)
+        t_end = steps * probe.shear_rate()
+        load = load_average()
+        start, cpu0 = time.monotonic(), os.times()
+        rc = launch([str(bendlab)] + probe.arguments(folder, t_end=t_end), folder, False)
+        wall, cpu1 = time.monotonic() - start, os.times()
+        cpu = (cpu1.children_user - cpu0.children_user) + (cpu1.children_system - cpu0.children_system)
+        s = read_json(folder / "summary.json")
+        if rc != 0 or s is None:
+            print(f"cost probe {key} failed (exit {rc}); see {folder / 'run.log'}", file=sys.stderr)
+            continue
+        n = s["lattice"]["steps"]
+        cache[key] = {"radius": run.radius, "triangles": run.triangles, "box": list(run.box),
+                      "nodes": s["lattice"]["nodes"], "steps": steps, "lattice_steps": n,
+                      "run_seconds": s["wall_seconds"], "process_seconds": wall,
+                      "seconds_per_step": s["wall_seconds"] / n,
+                      # CPU time of the whole process (setup included) per step: what the step costs
+                      # on a machine that is not shared, per thread-second
+                      "cpu_seconds_per_step": cpu / n,
+                      "mlups": math.prod(s["lattice"]["nodes"]) * n / s["wall_seconds"] / 1e6,
+                      "load_average_before": load, "load_average_after": load_average(),
+                      "omp_threads": os.environ.get("OMP_NUM_THREADS", "default")}
+        cache_path.write_text(json.dumps(cache, indent=2) + "\n")
+    return cache
+
+
+def cost_key(run):
+    return f"R{fmt_g(run.radius)}_mt1-{run.triangles}_box{'x'.join(fmt_g(b) for b in run.box)}"
+
+
+def seconds_per_step(run, cost, key="seconds_per_step"):
+    """Measured, else scaled by node count from the largest measured case (the fluid dominates)."""
+    if cost_key(run) in cost and key in cost[cost_key(run)]:
+        return cost[cost_key(run)][key], "measured"
+    cost = {k: c for k, c in cost.items() if key in c}
+    if not cost:
+        return None, "no measurement"
+    ref = max(cost.values(), key=lambda c: math.prod(c["nodes"]))
+    return ref[key] * math.prod(run.nodes()) / math.prod(ref["nodes"]), \
+        f"scaled from R = {fmt_g(ref['radius'])} by node count"
+
+
+def read_series(folder):
+    try:
+        with open(folder / "timeseries.csv", newline="") as f:
+            rows = list(csv.DictReader(f))
+    except OSError:
+        return None
+    return {k: np.array([float(r[k]) for r in rows]) for k in ("gamma_t", "D")} if rows else None
+
+
+def fit_extrapolation(radii, D):
+    """D(R) = D_inf + a / R^p through three points (p from the ratio of differences), or with p = 1
+    through two. Returns (D_inf, a, p) or None."""
+    R = np.asarray(radii, float)
+    D = np.asarray(D, float)
+    if len(R) < 2:
+        return None
+    if len(R) >= 3:
+        R, D = R[-3:], D[-3:]
+        ratio = (D[0] - D[1]) / (D[1] - D[2]) if D[1] != D[2] else math.nan
+
+        def f(p):
+            return (R[0] ** -p - R[1] ** -p) / (R[1] ** -p - R[2] ** -p) - ratio
+        if math.isfinite(ratio) and ratio > 0:
+            lo, hi = 0.05, 8.0
+            if f(lo) * f(hi) < 0:
+                for _ in range(200):
+                    mid = 0.5 * (lo + hi)
+                    lo, hi = (mid, hi) if f(lo) * f(mid) > 0 else (lo, mid)
+                p = 0.5 * (lo + hi)
+                a = (D[1] - D[2]) / (R[1] ** -p - R[2] ** -p)
+                return D[2] - a * R[2] ** -p, a, p
+    # p = 1, least squares over the points
+    A = np.vstack([np.ones_like(R), 1 / R]).T
+    (d_inf, a), *_ = np.linalg.lstsq(A, D, rcond=None)
+    return d_inf, a, 1.0
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--radii", default="6,8,10")
+    ap.add_argument("--full", action="store_true", help="add R = 13.5 with 5120 triangles (the paper's size)")
+    ap.add_argument("--t-end", type=float, default=10.0)
+    ap.add_argument("--measure-steps", type=int, default=300)
+    ap.add_argument("--only-measure", action="store_true")
+    ap.add_argument("--no-runs", action="store_true", help="write the document from the work folder only")
+    ap.add_argument("--no-bim", action="store_true", help="do not run missing BIM runs")
+    ap.add_argument("--bendlab", default=str(ROOT / "build/release/bendlab"))
+    ap.add_argument("--work", default=str(ROOT / "results/lbm_study"))
+    ap.add_argument("--bim-work", default=str(ROOT / "results/shear_study"))
+    ap.add_argument("--doc", default=str(ROOT / "docs/results/lbm.md"))
+    a = ap.parse_args()
+    bendlab = Path(a.bendlab)
+    work, bim_work = Path(a.work), Path(a.bim_work)
+    work.mkdir(parents=True, exist_ok=True)
+    radii = [float(r) for r in a.radii.split(",")]
+
+    runs = []
+    for (G, kb) in PAIRS:
+        for R in radii:
+            runs += [LbmRun(m, G, kb, R, 1280, BOX, a.t_end) for m in METHODS]
+            runs.append(LbmRun("none", G, 0.0, R, 1280, BOX, a.t_end))
+        if a.full:
+            runs += [LbmRun(m, G, kb, FULL_R, 5120, FULL_BOX, a.t_end) for m in METHODS]
+            runs.append(LbmRun("none", G, 0.0, FULL_R, 5120, FULL_BOX, a.t_end))
+    bim_runs = sorted({BimRun(r.method, r.G, r.kappa_b, a.t_end) for r in runs}, key=lambda b: b.name)
+
+    # Cost per step, one probe per distinct lattice (the fluid dominates; method A's forces stand in).
+    probes = {}
+    for r in runs:
+        if r.method == "A" and cost_key(r) not in probes and r.radius in radii[:2]:
+            probes[cost_key(r)] = r
+    cost = read_json(work / "cost.json") or {}
+    if not a.no_runs:
+        cost = measure_cost(list(probes.values()), work, bendlab, a.measure_steps)
+    total = total_cpu = 0.0
+    projected = {}
+    print(f"load average now: {' '.join(load_average())}")
+    for r in runs:
+        sps, how = seconds_per_step(r, cost)
+        done = finished_summary(work / r.name, r) is not None
+        projected[r] = (sps * r.steps() if sps else None, how)
+        cps, _ = seconds_per_step(r, cost, "cpu_seconds_per_step")
+        projected[r] = projected[r] + (cps * r.steps() if cps else None,)
+        if sps and not done:
+            total += sps * r.steps()
+        if cps and not done:
+            total_cpu += cps * r.steps()
+    for k, c in sorted(cost.items()):
+        print(f"cost {k}: {c['seconds_per_step'] * 1e3:.2f} ms per step ({c['mlups']:.1f} MLUPS, "
+              f"{c['lattice_steps']} steps, load {' '.join(c['load_average_before'])})")
+    print(f"projected wall time of the LBM runs still to do, one at a time, at the measured load: {total / 3600:.1f} h")
+    print(f"projected CPU time of the same runs (a machine to themselves, one thread each): {total_cpu / 3600:.1f} h")
+    totals = (total, total_cpu)
+    if a.only_measure:
+        write_doc(a, runs, bim_runs, work, bim_work, cost, projected, totals)
+        return
+
+    if not a.no_runs:
+        for r in sorted(runs, key=lambda r: (r.steps() * math.prod(r.nodes()), r.name)):
+            execute(r, work / r.name, bendlab)
+        if not a.no_bim:
+            for b in bim_runs:
+                execute(b, bim_work / b.name, bendlab)
+    write_doc(a, runs, bim_runs, work, bim_work, cost, projected, totals)
+
+
+def write_doc(a, runs, bim_runs, work, bim_work, cost, projected, totals):
+    total, total_cpu = totals
+    doc = Path(a.doc)
+    figdir = doc.parent / "lbm"
+    figdir.mkdir(parents=True, exist_ok=True)
+    L = ["# Capsule in shear flow: immersed-boundary lattice Boltzmann beside the BIM (figure 15)", "",
+         "Generated by `scripts/lbm_study.py` (do not edit by hand). Every number below is read from the run",
+         "folders in `results/lbm_study` (LBM) and `results/shear_study` (BIM); a case without a finished run",
+         "says so.", "",
+         f"Setup (shared/spec/LBM_IBM.md sections 0-5): D3Q19, tau = {fmt_g(TAU)}, Re = R v / nu = {fmt_g(REYNOLDS)}, "
+         f"box {' x '.join(fmt_g(b) for b in BOX)} R (walls at z = +-{fmt_g(BOX[2] / 2)} R), phi2 kernel, ESPResSo's",
+         "volume force with kappa_V = 100 kappa_S, 1280 triangles (MT1), gamma t = "
+         f"{fmt_g(a.t_end)}, steady D over the last half. D(R) = D_inf + a / R^p through the radii.", ""]
+    finished = sum(finished_summary(work / r.name, r) is not None for r in runs)
+    L += [f"**Finished LBM runs: {finished} of {len(runs)}.** Unfinished runs appear below with their status",
+          "(not run, or started with the gamma t of their last checkpoint) and their projected time.", ""]
+    # Cost
+    L += ["## Cost per step and projected time", "",
+          "Each lattice was timed by a short run (`--measure-steps` lattice steps, setup included) on the",
+          "machine the script ran on, with the load average (all processes, 2 cores) noted: wall time under",
+          "that load, and the process's CPU time, which is closer to what the step costs on a machine that",
+          "is not shared.", "",
+          "| lattice | nodes | wall seconds per step | CPU seconds per step | MLUPS (wall) | load average before | measured with |",
+          "|---|---|---|---|---|---|---|"]
+    for k, c in sorted(cost.items()):
+        cpu = f"{c['cpu_seconds_per_step']:.4f}" if "cpu_seconds_per_step" in c else "-"
+        L.append(f"| {k} | {'x'.join(str(n) for n in c['nodes'])} | {c['seconds_per_step']:.4f} | {cpu} | {c['mlups']:.1f} | "
+                 f"{' '.join(c['load_average_before'])} | {c['lattice_steps']} steps, OMP_NUM_THREADS={c['omp_threads']} |")
+    if not cost:
+        L.append("| (not measured yet) | | | | | | |")
+    L += ["", "| run | lattice steps | status | wall time |", "|---|---|---|---|"]
+    for r in runs:
+        folder = work / r.name
+        s = finished_summary(folder, r)
+        if s is not None:
+            status, wall = "finished", f"{s['wall_seconds'] / 60:.1f} min"
+        else:
+            cp = read_json(folder / "checkpoint.json")
+            status = f"started, checkpoint at gamma t = {cp['time']:.2f}" if cp else "not run"
+            sec, how, cpu = projected[r]
+            wall = (f"projected {sec / 3600:.2f} h wall, {cpu / 3600:.2f} h CPU ({how})" if sec and cpu else
+                    f"projected {sec / 3600:.2f} h wall ({how})" if sec else "not projected")
+        L.append(f"| {r.label()} ({r.triangles} triangles) | {r.steps()} | {status} | {wall} |")
+    L += ["", f"Projected time of the unfinished LBM runs, one after another: **{total / 3600:.1f} h** of wall time "
+              f"at the measured load, **{total_cpu / 3600:.1f} h** of CPU time. Larger lattices are scaled from the",
+          "largest measured one by node count.", ""]
+    # Results
+    L += ["## Steady deformation", "",
+          "| G | kB_hat | method | " + " | ".join(f"D (R = {fmt_g(R)})" for R in sorted({r.radius for r in runs}))
+          + " | D_inf (p) | smallest R within 2 % | BIM 1280 |",
+          "|---|---|---|" + "---|" * (len({r.radius for r in runs}) + 3)]
+    cases = sorted({(r.G, r.kappa_b, r.method) for r in runs})
+    figs = []
+    for (G, kb, m) in cases:
+        rs = sorted([r for r in runs if (r.G, r.kappa_b, r.method) == (G, kb, m) and r.triangles == 1280],
+                    key=lambda r: r.radius)
+        cells, pts = [], []
+        for r in sorted([r for r in runs if (r.G, r.kappa_b, r.method) == (G, kb, m)], key=lambda r: r.radius):
+            s = finished_summary(work / r.name, r)
+            cells.append(f"{s['D_steady']:.4f}" if s and s.get("D_steady") is not None else "-")
+            if s and s.get("D_steady") is not None and r in rs:
+                pts.append((r.radius, s["D_steady"]))
+        fit = fit_extrapolation([p[0] for p in pts], [p[1] for p in pts]) if len(pts) >= 2 else None
+        fit_cell = f"{fit[0]:.4f} ({fit[2]:.2f})" if fit else "needs 2 radii"
+        within = "-"
+        if fit:
+            ok = [R for R, D in pts if abs(D - fit[0]) <= 0.02 * abs(fit[0])]
+            within = fmt_g(min(ok)) if ok else "none"
+        b = BimRun(m, G, kb, a.t_end)
+        bs = finished_summary(bim_work / b.name, b)
+        bim = f"{bs['D_steady']:.4f}" if bs and bs.get("D_steady") is not None else "not run"
+        L.append(f"| {fmt_g(G)} | {fmt_g(kb)} | {m} | " + " | ".join(cells) + f" | {fit_cell} | {within} | {bim} |")
+        # figure: D(gamma t), LBM at each R beside the BIM
+        fig, ax = plt.subplots(figsize=(5.5, 3.6))
+        any_line = False
+        for r in sorted([r for r in runs if (r.G, r.kappa_b, r.method) == (G, kb, m)], key=lambda r: r.radius):
+            ser = read_series(work / r.name)
+            if ser is not None:
+                ax.plot(ser["gamma_t"], ser["D"], label=f"LBM R = {fmt_g(r.radius)}")
+                any_line = True
+        ser = read_series(bim_work / b.name)
+        if ser is not None:
+            ax.plot(ser["gamma_t"], ser["D"], "k--", label="BIM 1280")
+            any_line = True
+        if any_line:
+            ax.set_xlabel("gamma t")
+            ax.set_ylabel("D")
+            ax.set_title(f"G = {fmt_g(G)}, kB_hat = {fmt_g(kb)}, method {m}")
+            ax.legend(fontsize=8)
+            fig.tight_layout()
+            png = figdir / f"D_G{fmt_g(G)}_kb{fmt_g(kb)}_{m}.png"
+            fig.savefig(png, dpi=110)
+            figs.append(f"![D against gamma t, G = {fmt_g(G)}, kB_hat = {fmt_g(kb)}, method {m}](lbm/{png.name})")
+        plt.close(fig)
+    L += ["", "A dash: the run has not finished. Partial runs (a time series but no summary) are drawn as far as",
+          "they got. The BIM column reads `results/shear_study` (scripts/shear_study.py's runs).", ""]
+    L += ["## D against gamma t", ""] + [f + "\n" for f in figs] if figs else []
+    doc.write_text("\n".join(L) + "\n")
+    print(f"wrote {doc}")
+
+
+if __name__ == "__main__":
+    main()
