@@ -11,6 +11,8 @@
 
 #include <Eigen/Dense>
 
+#include "bendlab/integrate/integrator.hpp"
+
 namespace bendlab {
 
 struct CashKarpOptions {
@@ -25,28 +27,23 @@ struct CashKarpOptions {
   std::int64_t max_steps = 100'000'000;  ///< accepted + rejected steps; more throws bendlab::Error
 };
 
-struct CashKarpStats {
-  std::int64_t accepted = 0, rejected = 0, rhs_evaluations = 0;
-  double t = 0;        ///< time reached
-  double dt_next = 0;  ///< the step the controller proposes next (to resume an integration)
-  bool stopped = false;  ///< the callback asked to stop
-};
+/// accepted, rejected, rhs_evaluations, t, dt_next, stopped (integrator.hpp).
+using CashKarpStats = IntegratorStats;
 
-class CashKarp {
+class CashKarp final : public AdaptiveIntegrator {
  public:
-  using State = Eigen::VectorXd;
-  /// dydt = f(t, y); dydt is preallocated to the size of y.
-  using Rhs = std::function<void(double t, const State& y, State& dydt)>;
-  /// Called after every accepted step with the new time, the step taken and the new state, which
-  /// it may modify (e.g. a projection); returns false to stop the integration.
-  using OnAccept = std::function<bool(double t, double dt, State& y)>;
+  // State, Rhs (dydt = f(t, y), dydt preallocated to the size of y) and OnAccept (called after
+  // every accepted step; may modify y; returns false to stop): see integrator.hpp.
+  using AdaptiveIntegrator::OnAccept;
+  using AdaptiveIntegrator::Rhs;
+  using AdaptiveIntegrator::State;
 
   explicit CashKarp(CashKarpOptions options = {});
 
   /// Integrates y from t0 to t1 (t1 > t0), starting with step dt0 (options.dt_initial when <= 0).
   /// The last step is shortened to land on t1 exactly.
   CashKarpStats integrate(const Rhs& rhs, double t0, double t1, State& y, double dt0 = 0,
-                          const OnAccept& on_accept = {});
+                          const OnAccept& on_accept = {}) override;
 
   /// One Cash-Karp step of size dt from (t, y): the fifth-order result y5 and the difference
   /// y5 - y4 of the embedded pair. Takes 6 evaluations of rhs.
@@ -58,7 +55,8 @@ class CashKarp {
   const CashKarpOptions& options() const { return options_; }
   /// The step the controller will try next; inside on_accept, the proposal after that step
   /// (what a checkpoint should store to resume the integration as it would have gone on).
-  double proposed_step() const { return proposed_; }
+  double proposed_step() const override { return proposed_; }
+  std::string name() const override { return "cash-karp"; }
 
  private:
   CashKarpOptions options_;
