@@ -28,8 +28,8 @@
 //
 // Step-size control (Sommeijer et al., section 2.4): after an accepted step
 //   fac = min(grow, 0.8 (h_n / h_{n-1}) err_{n-1}^{1/3} / err_n^{2/3})   (err_n^{-1/3} on the first
-//   step and after a rejection), h <- h max(0.1, fac); after a rejection, and until the next
-//   accepted step, fac <= 1. After a rejection h <- h max(reject_floor, 0.8 err^{-1/3}): the floor
+//   step and after a rejection), h <- h max(shrink = 0.1, fac), and fac <= 1 on the first accepted
+//   step after a rejection. After a rejection h <- h max(reject_floor, 0.8 err^{-1/3}): the floor
 //   (0.5 by default) keeps one kink of f (the mixed area of a capsule switches formula when an
 //   angle passes 90 degrees, so err can jump by orders of magnitude) from collapsing the step.
 //
