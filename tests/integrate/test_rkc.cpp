@@ -253,13 +253,13 @@ struct ModifiedProblem {
 
 TEST(Rkc, ModificationInOnAcceptReevaluatesFirstStageAndResumesIdentically) {
   RkcOptions o;
-  o.rtol = o.atol = 1e-6;
+  o.rtol = o.atol = 1e-4;
   o.spectral_interval = 5;
   ModifiedProblem p;
   // Uninterrupted run.
   State y_full = p.start();
   Rkc full(o);
-  full.integrate(p.rhs, 0.0, 2.0, y_full, 0.0, p.project);
+  full.integrate(p.rhs, 0.0, 1.0, y_full, 0.0, p.project);
   const RkcStats st = full.stats();
   ASSERT_GT(st.accepted, 10);
   EXPECT_EQ(st.fsal_reused, 0);  // every step modified y, so f was evaluated again
@@ -273,10 +273,10 @@ TEST(Rkc, ModificationInOnAcceptReevaluatesFirstStageAndResumesIdentically) {
   RkcCheckpoint c;
   bool have = false;
   int pieces = 0;
-  while (t < 2.0 && pieces < 100000) {
+  while (t < 1.0 && pieces < 100000) {
     Rkc piece(o);
     if (have) piece.restore(c);
-    piece.integrate(p.rhs, t, 2.0, y, 0.0, [&](double tn, double dt, State& s) {
+    piece.integrate(p.rhs, t, 1.0, y, 0.0, [&](double tn, double dt, State& s) {
       p.project(tn, dt, s);
       t = tn;
       c = piece.checkpoint();
@@ -292,7 +292,7 @@ TEST(Rkc, ModificationInOnAcceptReevaluatesFirstStageAndResumesIdentically) {
   stale.reuse_f_after_modification = true;
   Rkc r(stale);
   State y_stale = p.start();
-  r.integrate(p.rhs, 0.0, 2.0, y_stale, 0.0, p.project);
+  r.integrate(p.rhs, 0.0, 1.0, y_stale, 0.0, p.project);
   EXPECT_EQ(r.stats().fsal_reused, r.stats().accepted);
   EXPECT_GT((y_stale - y_full).lpNorm<Eigen::Infinity>(), 0.0);
   EXPECT_LT((y_stale - y_full).lpNorm<Eigen::Infinity>(), 1e-3);
