@@ -21,7 +21,7 @@ namespace bendlab::cli {
 namespace {
 
 struct ShearArgs {
-  std::string solver = "bim", method = "none", mesh = "mt1:1280", out, plot_script;
+  std::string solver = "bim", method = "none", mesh = "mt1:1280", out, plot_script, integrator = "cash-karp";
   double G = 0.1, t_end = 10, snapshot_every = 0.5, rtol = 1e-7, atol = 1e-6;
   std::optional<double> kappa_b_hat, kappa_b;
   int rings = 0;
@@ -55,6 +55,7 @@ void shear(const ShearArgs& a) {
   spec.kappa_b = a.kappa_b;
   spec.t_end = a.t_end;
   spec.snapshot_every = a.snapshot_every;
+  spec.integrator = a.integrator;
   spec.rtol = a.rtol;
   spec.atol = a.atol;
   spec.resume = a.resume;
@@ -96,8 +97,11 @@ const CommandRegistration registration([](CLI::App& app) {
                               "dimensional bending modulus kB = kappa_b_hat / G (R = mu = gamma = 1)");
   hat->excludes(dim);
   cmd->add_option("--t-end", args->t_end, "end of the run in gamma t")->capture_default_str();
-  cmd->add_option("--rtol", args->rtol, "relative tolerance of the Cash-Karp stepper")->capture_default_str();
-  cmd->add_option("--atol", args->atol, "absolute tolerance of the Cash-Karp stepper, in units of R")->capture_default_str();
+  cmd->add_option("--integrator", args->integrator,
+                  "time integrator: cash-karp (the paper's) or rkc (Runge-Kutta-Chebyshev, stiff-stable)")
+      ->capture_default_str();
+  cmd->add_option("--rtol", args->rtol, "relative tolerance of the adaptive integrator")->capture_default_str();
+  cmd->add_option("--atol", args->atol, "absolute tolerance of the adaptive integrator, in units of R")->capture_default_str();
   cmd->add_option("--snapshot-every", args->snapshot_every, "gamma t between .vtp snapshots and checkpoints")
       ->capture_default_str();
   cmd->add_flag("--resume", args->resume, "continue the run in --out from its last checkpoint");
