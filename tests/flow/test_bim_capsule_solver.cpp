@@ -143,12 +143,14 @@ TEST(BimCapsuleSolver, RkcRestoredStateContinuesTheSameTrajectory) {
   Points saved;
   double t_saved = 0;
   SolverState state;
+  SolverCounters counters;
   int steps = 0;
   EXPECT_FALSE(first.advance(0.3, [&](const AcceptedStep& s) {
     if (++steps < 7) return true;  // past one re-estimate of the spectral radius, before the next
     saved = *s.positions;
     t_saved = s.time;
     state = first.save_state({}, "0");  // inside the step, as run_capsule does
+    counters = first.counters();
     return false;
   }));
   ASSERT_GT(t_saved, 0.0);
@@ -158,7 +160,7 @@ TEST(BimCapsuleSolver, RkcRestoredStateContinuesTheSameTrajectory) {
   // Through text, as a checkpoint file stores it.
   const nlohmann::json fields = nlohmann::json::parse(state.fields.dump());
   BimCapsuleSolver resumed(mem, rkc(1e-7, 1e-6));
-  resumed.restore_state(saved, t_saved, first.counters(), fields, {}, "test");
+  resumed.restore_state(saved, t_saved, counters, fields, {}, "test");
   resumed.advance(0.3, {});
   EXPECT_EQ(resumed.positions(), full.positions());
   EXPECT_EQ(resumed.counters().velocity_evaluations, full.counters().velocity_evaluations);
@@ -178,8 +180,10 @@ TEST(BimCapsuleSolver, RkcRestoredStateContinuesTheSameTrajectory) {
 
 TEST(BimCapsuleSolver, RkcErrorFallsAsTheToleranceIsTightened) {
   // D(t_end) of RKC against a tight Cash-Karp reference, in the stiff case: RKC's error estimate
-  // is of the position, so D's error must fall with the tolerance (order 2: rtol^(2/3) per step
-  // count rtol^(-1/3) in theory; here only monotone decrease and the tight end are asserted).
+  // is of the position, so D's error must fall with the tolerance: a second-order method with the
+  // step ~ rtol^(1/3) has a global error ~ rtol^(2/3), a factor 21.5 per two decades (measured at
+  // 1e-4, 1e-6, 1e-8: 16 and 19, the error dominated by the fast start from the sphere); asserted
+  // is a factor of more than 8 per two decades.
   const auto mem = bending_membrane();
   const double t_end = 0.5;
   auto D_at_end = [&](std::unique_ptr<Integrator> integrator) {
@@ -194,8 +198,8 @@ TEST(BimCapsuleSolver, RkcErrorFallsAsTheToleranceIsTightened) {
   std::vector<double> errors;
   for (const double rtol : {1e-4, 1e-6, 1e-8}) errors.push_back(std::abs(D_at_end(rkc(rtol, 10 * rtol)) - reference));
   EXPECT_GT(reference, 0.1);
-  EXPECT_LT(errors[1], errors[0]);
-  EXPECT_LT(errors[2], errors[1]);
-  EXPECT_LT(errors[2], 1e-6 * reference);
+  EXPECT_LT(errors[1], errors[0] / 8);
+  EXPECT_LT(errors[2], errors[1] / 8);
+  EXPECT_LT(errors[2], 2e-5 * reference);
   EXPECT_LT(errors[0], 1e-2 * reference);
 }
