@@ -58,11 +58,20 @@ def load(folder):
         s = dict(c["arguments"])
         s["velocity_evaluations"] = c.get("counters", {}).get("velocity_evaluations")
         s["wall_seconds"] = c.get("wall_seconds")
+        s["_t_counted"] = c["time"]  # the counters are those of the checkpoint
+        integ = c.get("solver_state", {}).get("integrator")
+        if integ:
+            s["integrator"] = integ["name"]
+            tot = integ["state"]["totals"]
+            s["integrator_stats"] = {"mean_stages": tot["stages"] / max(tot["steps"], 1),
+                                     "max_stages": tot["max_stages"],
+                                     "spectral_radius": integ["state"]["spectral_radius"]}
     t, D = read_series(folder)
     s["_folder"] = folder
     s["_finished"] = finished
     s["_t_reached"] = t[-1] if t else 0.0
     s["_D2"] = D_at(t, D, 2.0)
+    s.setdefault("_t_counted", s["_t_reached"])
     s.setdefault("integrator", s.get("integrator", "cash-karp"))
     return s
 
@@ -88,14 +97,14 @@ def main():
         w(f"### {mesh}, Method {method}, G = {G}, κ̂_B = {kb}")
         w("")
         w("| integrator | rtol / atol | γt reached | D_steady | D(2) | D(2) vs Cash-Karp | velocity evaluations"
-          " | evaluations per unit γt | fewer than Cash-Karp (per unit γt) | mean / max stages | ρ (last, ×1.1) | wall |")
+          " (at the checkpoint for a running run) | evaluations per unit γt | fewer than Cash-Karp (per unit γt) | mean / max stages | ρ (last, ×1.1) | wall |")
         w("|---|---|---|---|---|---|---|---|---|---|---|---|")
         for r in sorted(rs, key=lambda r: (r["integrator"] != "cash-karp", -r.get("rtol", 0))):
             ev = r.get("velocity_evaluations")
-            per = ev / r["_t_reached"] if ev and r["_t_reached"] > 0 else None
+            per = ev / r["_t_counted"] if ev and r["_t_counted"] > 0 else None
             ref_per = None
             if ref and ref.get("velocity_evaluations") and ref["_t_reached"] > 0:
-                ref_per = ref["velocity_evaluations"] / ref["_t_reached"]
+                ref_per = ref["velocity_evaluations"] / ref["_t_counted"]
             gain = ref_per / per if per and ref_per and r is not ref else None
             dev = None
             if ref and r is not ref and r["_D2"] is not None and ref["_D2"] is not None:
@@ -105,7 +114,7 @@ def main():
             rho = fmt(st.get("spectral_radius"), ".3g") if st else "–"
             wall = r.get("wall_seconds")
             state = "" if r["_finished"] else " (running)"
-            w(f"| {r['integrator']}{state} | {r.get('rtol', '?')} / {r.get('atol', '?')} | {r['_t_reached']:.4g} | "
+            w(f"| {r['integrator']}{state} | {r.get('rtol', '–')} / {r.get('atol', '–')} | {r['_t_reached']:.4g} | "
               f"{fmt(r.get('D_steady'), '.6f')} | {fmt(r['_D2'], '.6f')} | "
               f"{'reference' if r is ref else (fmt(100 * dev, '+.4f') + '%' if dev is not None else '–')} | "
               f"{fmt(ev, 'd')} | {fmt(per, '.0f')} | {fmt(gain, '.1f') + '×' if gain else '–'} | {stages} | {rho} | "
