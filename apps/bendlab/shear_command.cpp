@@ -22,7 +22,7 @@ namespace bendlab::cli {
 namespace {
 
 struct ShearArgs {
-  std::string solver = "bim", method = "none", mesh = "mt1:1280", out, plot_script;
+  std::string solver = "bim", method = "none", mesh = "mt1:1280", out, plot_script, integrator = "cash-karp";
   double G = 0.1, t_end = 10, snapshot_every = 0.5, rtol = 1e-7, atol = 1e-6;
   std::optional<double> kappa_b_hat, kappa_b;
   int rings = 0;
@@ -49,11 +49,12 @@ void plot(const ShearArgs& a) {
 
 void shear(const ShearArgs& a) {
   if (a.solver == "lbm" && a.given_tolerance)
-    throw Error("--rtol and --atol are for --solver bim: the lattice Boltzmann solver takes fixed steps");
+    throw Error("--integrator, --rtol and --atol are for --solver bim: the lattice Boltzmann solver takes fixed steps");
   if (a.solver == "bim" && a.given_lattice)
     throw Error("--radius-lu, --box, --tau, --reynolds, --kernel and --sample-every are for --solver lbm");
   ShearRunSpec spec;
   spec.lattice = a.lattice;
+  spec.integrator = a.integrator;
   spec.folder = a.out;
   spec.solver = a.solver;
   spec.method = a.method;
@@ -108,10 +109,13 @@ const CommandRegistration registration([](CLI::App& app) {
   hat->excludes(dim);
   cmd->add_option("--t-end", args->t_end, "end of the run in gamma t")->capture_default_str();
   auto tolerance = [args](const std::string&) { args->given_tolerance = true; };
+  cmd->add_option("--integrator", args->integrator,
+                  "time integrator of the BIM: cash-karp (the paper's) or rkc (Runge-Kutta-Chebyshev, stiff-stable)")
+      ->check(CLI::IsMember({"cash-karp", "rkc"}))->capture_default_str()->each(tolerance);
   auto lattice = [args](const std::string&) { args->given_lattice = true; };
-  cmd->add_option("--rtol", args->rtol, "relative tolerance of the Cash-Karp stepper (bim); above 1e-2 refused, "
+  cmd->add_option("--rtol", args->rtol, "relative tolerance of the adaptive integrator (bim); above 1e-2 refused, "
                   "above 1e-4 warned (less accurate D, theta)")->capture_default_str()->each(tolerance);
-  cmd->add_option("--atol", args->atol, "absolute tolerance of the Cash-Karp stepper, in units of R (bim); above "
+  cmd->add_option("--atol", args->atol, "absolute tolerance of the adaptive integrator, in units of R (bim); above "
                   "1e-2 refused, above 1e-4 warned")->capture_default_str()->each(tolerance);
   cmd->add_option("--radius-lu", args->lattice.radius_lu, "capsule radius R in lattice units (lbm)")
       ->capture_default_str()->each(lattice);

@@ -35,6 +35,19 @@ def test_stop_and_resume_equals_an_uninterrupted_run(tmp_path):
     assert filecmp.cmp(tmp_path / "full" / "timeseries.csv", tmp_path / "parts" / "timeseries.csv", shallow=False)
 
 
+def test_an_rkc_run_resumes_from_the_cli_and_equals_the_python_run(tmp_path, cli):
+    rkc = dict(COMMON, integrator="rkc")
+    full = bendlab.shear_run(tmp_path / "full", **rkc)
+    assert full["integrator"] == "rkc" and full["integrator_stats"]["mean_stages"] >= 2
+    assert bendlab.shear_run(tmp_path / "parts", stop_after_steps=3, **rkc) is None
+    cli("shear", "--integrator", "rkc", "--method", "C", "--mesh", "mt1:320", "--G", "0.1", "--kappa-b-hat", "0.05",
+        "--t-end", "0.3", "--snapshot-every", "0.1", "--no-plot", "--resume", "--out", tmp_path / "parts")
+    assert without_wall(bendlab.read_summary(tmp_path / "parts")) == without_wall(full)
+    assert filecmp.cmp(tmp_path / "full" / "timeseries.csv", tmp_path / "parts" / "timeseries.csv", shallow=False)
+    with pytest.raises(Exception, match="integrator"):
+        bendlab.shear_run(tmp_path / "bad", **dict(COMMON, integrator="euler"))
+
+
 def test_progress_reaches_the_callback_and_ctrl_c_stops_cleanly(tmp_path):
     seen = []
 

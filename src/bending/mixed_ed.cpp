@@ -18,7 +18,7 @@ std::unique_ptr<BendingMethod> MixedEDMethod::create(const MethodOptions& option
 MethodInfo MixedEDMethod::info() {
   MethodInfo m{"ED", "E for n, H and K, D (heat kernel) for Lap H: the paper's conclusion",
                 {farutin_rings_option()}, {}, &MixedEDMethod::create};
-  m.capabilities.cost = std::string("O(N^2)");
+  m.capabilities.cost = std::string("O(N)");
   return m;
 }
 

@@ -224,6 +224,8 @@ CapsuleRunResult run_capsule(CapsuleSolver& solver, const CapsuleRunOptions& o) 
       {"initial_volume", membrane.reference_volume()},
       {"wall_seconds", wall_before + elapsed()}};
   for (const auto& [key, value] : fields.items()) summary[key] = value;
+  const nlohmann::json solver_fields = solver.summary();
+  for (const auto& [key, value] : solver_fields.items()) summary[key] = value;
   AtomicFile f(folder / "summary.json");
   f.stream() << summary.dump(2) << '\n';
   f.commit();

@@ -254,3 +254,69 @@ TEST(BelkinMethod, RedBloodCell5120) {
   EXPECT_LT(a.eh_mean, 0.05);
   EXPECT_GT(a.fraction(), 0.9);
 }
+
+namespace {
+double rel_max_diff(const Eigen::MatrixXd& a, const Eigen::MatrixXd& ref) {
+  return (a - ref).cwiseAbs().maxCoeff() / ref.cwiseAbs().maxCoeff();
+}
+// A smooth, non-symmetric deformation of the RBC (as a capsule in shear flow gets).
+Points deformed(const Points& x) {
+  Points y = x;
+  for (int i = 0; i < x.rows(); ++i) {
+    y(i, 0) += 0.3 * x(i, 2) + 0.05 * std::sin(3 * x(i, 1));
+    y(i, 1) *= 0.8;
+    y(i, 2) += 0.1 * x(i, 0) * x(i, 0);
+  }
+  return y;
+}
+}  // namespace
+
+// The O(N) grid form (kernel weights below kernel_cutoff dropped) against the O(N^2) reference:
+// equal to 1e-8 relative (max norm) with the default cutoff, on the RBC and a deformed RBC at 1280
+// and 5120 triangles, for Lap of a scalar field and Method D's H (from Lap x) and force density.
+TEST(BelkinLaplacian, GridFormEqualsAllPairsForm) {
+  BelkinOptions all, grid;
+  all.neighbours = BelkinOptions::Neighbours::all;
+  for (int level : {3, 4}) {
+    const TriMesh m = sphere_mesh(MeshFamily::MT1, level);
+    for (bool deform : {false, true}) {
+      const Points x = deform ? deformed(rbc_points(m)) : rbc_points(m);
+      const MeshGeometry g = MeshGeometry::compute(m.topology(), x);
+      Scalars w(m.num_vertices());
+      for (int i = 0; i < w.size(); ++i) w[i] = std::sin(3 * x(i, 0)) + x(i, 2) * x(i, 1);
+      const BelkinLaplacian la(m.topology(), x, g, all), lg(m.topology(), x, g, grid);
+      const double dw = rel_max_diff(lg.apply(w), la.apply(w));
+      // Method D applies the operator to x and to H.
+      const BendingResult ra = BelkinMethod(all).compute(m.topology(), x, 1.0);
+      const BendingResult rg = BelkinMethod(grid).compute(m.topology(), x, 1.0);
+      const double dh = rel_max_diff(rg.H, ra.H);
+      const double df = rel_max_diff(rg.force_density, ra.force_density);
+      std::printf("[Belkin grid vs all, N_T=%d%s] rel. max diff Lap w %.2e, H %.2e, f %.2e\n", m.num_faces(),
+                  deform ? " deformed" : "", dw, dh, df);
+      EXPECT_LT(dw, 1e-8);
+      EXPECT_LT(dh, 1e-8);
+      EXPECT_LT(df, 1e-8);
+      if (level == 3) {
+        // With the reference's own cut (exponent 80) both keep the same terms: they differ by the
+        // order of summation only.
+        BelkinOptions same = grid;
+        same.kernel_cutoff = std::exp(-80.0);
+        const BelkinLaplacian ls(m.topology(), x, g, same);
+        EXPECT_LT(rel_max_diff(ls.apply(x), la.apply(x)), 1e-12);
+      }
+    }
+  }
+}
+
+TEST(BelkinMethod, NeighbourOptions) {
+  EXPECT_EQ(static_cast<const BelkinMethod&>(*BelkinMethod::create({})).options().neighbours,
+            BelkinOptions::Neighbours::grid);
+  const auto all = BelkinMethod::create({{"neighbours", "all"}});
+  EXPECT_EQ(static_cast<const BelkinMethod&>(*all).options().neighbours, BelkinOptions::Neighbours::all);
+  const auto cut = BelkinMethod::create({{"neighbours", "grid"}, {"kernel_cutoff", "1e-12"}});
+  EXPECT_EQ(static_cast<const BelkinMethod&>(*cut).options().kernel_cutoff, 1e-12);
+  EXPECT_THROW(BelkinMethod::create({{"neighbours", "some"}}), Error);
+  EXPECT_THROW(BelkinMethod::create({{"kernel_cutoff", "0"}}), Error);
+  EXPECT_THROW(BelkinMethod::create({{"kernel_cutoff", "1e-3x"}}), Error);
+  EXPECT_THROW(BelkinMethod::create({{"kernel_cutoff", "2"}}), Error);
+}

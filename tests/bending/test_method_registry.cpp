@@ -63,7 +63,13 @@ TEST(MethodRegistry, ListsTheBuiltInsInTableOrder) {
   EXPECT_FALSE(bending_method_info("C").capabilities.has_energy);
   EXPECT_FALSE(bending_method_info("A").capabilities.defines_H);
   EXPECT_FALSE(bending_method_info("B").capabilities.defines_lapH);
-  EXPECT_EQ(bending_method_info("D").capabilities.cost, "O(N^2)");
+  EXPECT_EQ(bending_method_info("D").capabilities.cost, "O(N)");  // the cell list (neighbours=grid)
+  ASSERT_EQ(bending_method_info("D").options.size(), 2u);
+  EXPECT_EQ(bending_method_info("D").options[0].name, "neighbours");
+  EXPECT_EQ(bending_method_info("D").options[0].choices, (std::vector<std::string>{"grid", "all"}));
+  EXPECT_EQ(bending_method_info("D").options[1].name, "kernel_cutoff");
+  EXPECT_NO_THROW(make_bending_method("D", {{"neighbours", "all"}}));
+  expect_error_naming([] { make_bending_method("D", {{"neighbours", "some"}}); }, "neighbours");
   EXPECT_EQ(bending_method_info("E").options.size(), 1u);
   EXPECT_EQ(bending_method_info("E").options[0].name, "rings");
   const MethodInfo& s = bending_method_info("S");

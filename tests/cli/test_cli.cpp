@@ -167,7 +167,9 @@ TEST_F(Cli, MethodsListsTheRegistryAsTableAndJson) {
   EXPECT_TRUE(j[6]["capabilities"]["needs_admissible_mesh"].get<bool>());
   EXPECT_TRUE(j[0]["capabilities"]["has_energy"].get<bool>());
   EXPECT_FALSE(j[2]["capabilities"]["has_energy"].get<bool>());
-  EXPECT_EQ(j[3]["capabilities"]["cost"], "O(N^2)");
+  EXPECT_EQ(j[3]["capabilities"]["cost"], "O(N)");
+  EXPECT_EQ(j[3]["options"][0]["name"], "neighbours");
+  EXPECT_EQ(j[3]["options"][1]["name"], "kernel_cutoff");
   EXPECT_EQ(j[0]["options"][0]["name"], "small_angle");
   EXPECT_EQ(j[0]["options"][0]["type"], "bool");
   const auto& rings = j[4]["options"][0];
@@ -335,7 +337,7 @@ TEST_F(Cli, ShearLbmWritesTheFilesOfABimRun) {
   const auto a = nlohmann::json::parse(slurp(bim / "summary.json"));
   const auto b = nlohmann::json::parse(slurp(lbm / "summary.json"));
   for (const auto& [key, value] : a.items())
-    if (key != "rtol" && key != "atol") {
+    if (key != "rtol" && key != "atol" && key != "integrator") {  // the BIM's stepping
       EXPECT_TRUE(b.contains(key)) << key;
     }
   EXPECT_EQ(b["solver"], "lbm");
@@ -375,6 +377,35 @@ TEST_F(Cli, ShearStoppedAndResumedEqualsUninterrupted) {
   a.erase("wall_seconds");
   b.erase("wall_seconds");
   EXPECT_EQ(a, b);
+}
+
+TEST_F(Cli, ShearRkcStoppedAndResumedEqualsUninterrupted) {
+  // The stiff case (Method C, kappa_b_hat = 0.15) with the Runge-Kutta-Chebyshev integrator: its
+  // controller memory and spectral radius travel in the checkpoint, so the resumed run repeats the
+  // uninterrupted one byte for byte.
+  const std::string common = " --integrator rkc --method C --mesh mt1:320 --G 0.2 --kappa-b-hat 0.15 --t-end 0.4"
+                             " --snapshot-every 0.1 --no-plot --out ";
+  const fs::path full = dir / "full", parts = dir / "parts";
+  CliRun r = run("shear" + common + full.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  r = run("shear --stop-after-steps 5" + common + parts.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  r = run("shear --resume" + common + parts.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(slurp(parts / "timeseries.csv"), slurp(full / "timeseries.csv"));
+  auto a = nlohmann::json::parse(slurp(full / "summary.json"));
+  auto b = nlohmann::json::parse(slurp(parts / "summary.json"));
+  a.erase("wall_seconds");
+  b.erase("wall_seconds");
+  EXPECT_EQ(a, b);
+  EXPECT_EQ(a["integrator"], "rkc");
+  EXPECT_GT(a["integrator_stats"]["spectral_radius"].get<double>(), 0.0);
+  // Resuming with the other integrator is refused: the integrator is part of the run's identity.
+  expect_refused(run("shear --integrator cash-karp --resume --method C --mesh mt1:320 --G 0.2 --kappa-b-hat 0.15"
+                     " --t-end 0.5 --no-plot --out " + parts.string()),
+                 "integrator", parts / "nothing");
+  expect_refused(run("shear --integrator euler --mesh mt1:320 --no-plot --out " + (dir / "e").string()), "integrator",
+                 dir / "e");
 }
 
 TEST_F(Cli, ShearModuliAndMissingPlotScript) {

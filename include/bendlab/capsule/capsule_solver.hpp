@@ -63,6 +63,9 @@ class CapsuleSolver {
   virtual bool advance(double t_end, const OnStep& on_step) = 0;
 
   virtual SolverCounters counters() const = 0;
+  /// Fields the solver adds to a run's summary.json (e.g. its integrator's statistics); they must
+  /// survive a resume, so a resumed run writes the same values as the uninterrupted one.
+  virtual nlohmann::json summary() const { return nlohmann::json::object(); }
 
   /// The solver's own state at the current time, beyond positions and time (which the run saves).
   /// `folder` is the run folder, `tag` a name unique to this checkpoint for side files.

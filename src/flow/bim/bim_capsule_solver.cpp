@@ -45,6 +45,8 @@ void BimCapsuleSolver::restart(const Points& positions, double time, double dt_n
   x_ = positions;
   t_ = time;
   dt_next_ = dt_next > 0 ? dt_next : 0;
+  integrator_resume_ = nullptr;
+  integrator_continues_ = false;
 }
 
 void BimCapsuleSolver::velocity(const Points& x, Points& u) {
@@ -97,6 +99,13 @@ bool BimCapsuleSolver::advance(double t_end, const OnStep& on_step) {
     s.positions = &x_;
     return on_step(s);
   };
+  if (!integrator_resume_.is_null()) {
+    integrator_->restore_checkpoint_state(integrator_resume_, integrator_resume_source_);
+    integrator_resume_ = nullptr;
+  } else if (integrator_continues_) {
+    integrator_->restore_checkpoint_state(integrator_->checkpoint_state(), "BIM");
+  }
+  integrator_continues_ = true;
   const IntegratorStats st = integrator_->integrate(rhs, t_, t_end, y, dt_next_, on_accept);
   counters_.rejected_steps = rejected_before + st.rejected;
   if (!st.stopped) dt_next_ = st.dt_next;
@@ -106,7 +115,16 @@ bool BimCapsuleSolver::advance(double t_end, const OnStep& on_step) {
 SolverState BimCapsuleSolver::save_state(const std::filesystem::path&, const std::string&) const {
   SolverState s;
   s.fields = {{"dt_next", dt_next_}};
+  nlohmann::json state = integrator_->checkpoint_state();
+  if (!state.empty()) s.fields["integrator"] = {{"name", integrator_->name()}, {"state", std::move(state)}};
   return s;
+}
+
+nlohmann::json BimCapsuleSolver::summary() const {
+  nlohmann::json j = {{"integrator", integrator_->name()}};
+  nlohmann::json stats = integrator_->summary();
+  if (!stats.empty()) j["integrator_stats"] = std::move(stats);
+  return j;
 }
 
 void BimCapsuleSolver::restore_state(const Points& positions, double time, const SolverCounters& counters,
@@ -115,7 +133,19 @@ void BimCapsuleSolver::restore_state(const Points& positions, double time, const
   if (!fields.is_object() || !fields.contains("dt_next") || !fields.at("dt_next").is_number() ||
       !std::isfinite(fields.at("dt_next").get<double>()) || fields.at("dt_next").get<double>() < 0)
     throw Error(fmt::format("{}: \"solver_state\": \"dt_next\" must be a finite number >= 0", source));
+  if (fields.contains("integrator")) {
+    const nlohmann::json& in = fields.at("integrator");
+    if (!in.is_object() || !in.contains("name") || !in.at("name").is_string() || !in.contains("state"))
+      throw Error(fmt::format("{}: \"solver_state\": \"integrator\" must be an object with \"name\" and \"state\"", source));
+    if (in.at("name").get<std::string>() != integrator_->name())
+      throw Error(fmt::format("{}: the checkpoint was written by integrator '{}', this run uses '{}'", source,
+                              in.at("name").get<std::string>(), integrator_->name()));
+  }
   restart(positions, time, fields.at("dt_next").get<double>());
+  if (fields.contains("integrator")) {
+    integrator_resume_ = fields.at("integrator").at("state");
+    integrator_resume_source_ = source;
+  }
   counters_ = counters;
 }
 

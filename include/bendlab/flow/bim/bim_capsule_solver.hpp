@@ -8,8 +8,10 @@
 // accepted step the shape is rescaled about its volume centroid to the reference volume.
 // Units: mu and gamma from BimOptions (1 and 1 for the shear run, shear_units.hpp).
 //
-// Its checkpoint state is {"dt_next": the step the integrator proposed next}, so that a resumed
-// run repeats the uninterrupted one step by step. Not for concurrent use of one object (the single
+// Its checkpoint state is {"dt_next": the step the integrator proposed next} and, for an integrator
+// with more state (RKC: controller memory, spectral radius and its vector), {"integrator": {"name",
+// "state"}}, so that a resumed run repeats the uninterrupted one step by step. Consecutive
+// advance() calls continue one integration; restart() starts a fresh one. Not for concurrent use of one object (the single
 // layer keeps per-call quadrature buffers); separate objects are independent.
 #include <memory>
 
@@ -43,6 +45,8 @@ class BimCapsuleSolver final : public CapsuleSolver {
   double time() const override { return t_; }
   bool advance(double t_end, const OnStep& on_step) override;
   SolverCounters counters() const override { return counters_; }
+  /// {"integrator": name, "integrator_stats": the integrator's summary()} (the latter when not empty).
+  nlohmann::json summary() const override;
   SolverState save_state(const std::filesystem::path& folder, const std::string& tag) const override;
   void restore_state(const Points& positions, double time, const SolverCounters& counters,
                      const nlohmann::json& fields, const std::filesystem::path& folder,
@@ -61,6 +65,9 @@ class BimCapsuleSolver final : public CapsuleSolver {
   StokesSingleLayer single_layer_;
   Points x_;
   double t_ = 0, dt_next_ = 0;
+  nlohmann::json integrator_resume_;  ///< a checkpoint's integrator state to continue from (null: none)
+  std::string integrator_resume_source_;
+  bool integrator_continues_ = false;  ///< the next advance() continues the last integration
   SolverCounters counters_;
   // Buffers reused by every evaluation (this object is not for concurrent use).
   Points xb_, density_, u_, grad_;

@@ -1,0 +1,72 @@
+// Method D's heat-kernel operator (belkin.hpp): the O(N) grid form against the O(N^2) reference
+// on the red blood cell of the study, with Method C for scale: the time of one force evaluation
+// each (processor seconds), and the grid form's relative difference (max norm) from the
+// reference, per kernel cut-off. Not a Google Benchmark: single runs (the reference is slow at
+// 81920 triangles).
+//
+//   belkin_neighbours TRIANGLES [CUTOFF ...] [skip-all]   (CUTOFF default 1e-15; skip-all: no reference)
+#include <fmt/format.h>
+
+#include <ctime>
+#include <string>
+#include <vector>
+
+#include "bendlab/bending/belkin.hpp"
+#include "bendlab/bending/bending_method.hpp"
+#include "bendlab/mesh/generators.hpp"
+#include "bendlab/surfaces/analytic_surface.hpp"
+
+using namespace bendlab;
+
+namespace {
+// Processor time (all threads): on a shared machine closer to the work done than the wall time.
+template <class F>
+double seconds(F&& f) {
+  const std::clock_t t0 = std::clock();
+  f();
+  return double(std::clock() - t0) / CLOCKS_PER_SEC;
+}
+double rel(const Points& a, const Points& ref) { return (a - ref).cwiseAbs().maxCoeff() / ref.cwiseAbs().maxCoeff(); }
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2) {
+    fmt::print(stderr, "usage: {} TRIANGLES [CUTOFF ...] [skip-all]\n", argv[0]);
+    return 2;
+  }
+  const long triangles = std::stol(argv[1]);
+  std::vector<double> cutoffs;
+  bool skip_all = false;
+  for (int k = 2; k < argc; ++k) {
+    if (std::string(argv[k]) == "skip-all")
+      skip_all = true;
+    else
+      cutoffs.push_back(std::stod(argv[k]));
+  }
+  if (cutoffs.empty()) cutoffs.push_back(1e-15);
+  const TriMesh m = sphere_mesh(MeshFamily::MT1, level_with_triangles(MeshFamily::MT1, triangles));
+  const Points x = make_rbc()->map_from_unit_sphere(m.positions());
+  BendingResult ref;
+  const auto c = make_bending_method("C");
+  BendingResult rc;
+  const double tc = seconds([&] { rc = c->compute(m.topology(), x, 1.0); });
+  fmt::print("triangles {} vertices {} | method C {:.3f} s\n", m.num_faces(), m.num_vertices(), tc);
+  if (!skip_all) {
+    BelkinOptions all;
+    all.neighbours = BelkinOptions::Neighbours::all;
+    const double ta = seconds([&] { ref = BelkinMethod(all).compute(m.topology(), x, 1.0); });
+    fmt::print("  D neighbours=all {:.3f} s\n", ta);
+  }
+  for (double cut : cutoffs) {
+    BelkinOptions grid;
+    grid.kernel_cutoff = cut;
+    BendingResult r;
+    const double tg = seconds([&] { r = BelkinMethod(grid).compute(m.topology(), x, 1.0); });
+    fmt::print("  D neighbours=grid kernel_cutoff={:g} {:.3f} s", cut, tg);
+    if (!skip_all)
+      fmt::print(" | rel. diff f {:.2e} H {:.2e}", rel(r.force_density, ref.force_density),
+                 (r.H - ref.H).cwiseAbs().maxCoeff() / ref.H.cwiseAbs().maxCoeff());
+    fmt::print("\n");
+  }
+  return 0;
+}
