@@ -88,7 +88,7 @@ PUBLISHED_D_G01 = (0.37, 0.40)
 # Gs the small-strain shear modulus and nu_s the surface Poisson ratio of the membrane
 # (equivalently D = Ca (15/8 + 5 Gs / (8 Ks)), Ks the area-dilatation modulus). The neo-Hookean law
 # has Ks = 3 Gs, nu_s = 1/2, so D = 25/12 Ca (the same as 25/4 mu gamma R / Es with the surface
-# Young modulus Es = 3 Gs). Our kS is 3 Gs (CONVENTIONS, section 2): Ca = 3 G and D = 25/4 G.
+# Young modulus Es = 3 Gs). Our kS is 3 Gs (docs/conventions.md §2): Ca = 3 G and D = 25/4 G.
 SMALL_DEFORMATION_SLOPE = 25.0 / 4.0
 
 METHOD_STYLE = {
@@ -442,7 +442,7 @@ def section_a(results, runs, fig_dir, rel, t_end):
         "small-strain shear modulus and nu_s the surface Poisson ratio of the membrane, whatever the "
         "viscosity ratio. The neo-Hookean law has nu_s = 1/2 (area-dilatation modulus 3 Gs), "
         "so D = 25/12 Ca, which is D = 25/4 mu gamma R / Es written with the surface "
-        "Young modulus Es = 3 Gs. Our kS is 3 Gs (CONVENTIONS, section 2), so Ca = 3 G and the "
+        "Young modulus Es = 3 Gs. Our kS is 3 Gs (docs/conventions.md §2), so Ca = 3 G and the "
         "theory gives **D = 25/4 G = 6.25 G**. (D = 25/4 Ca with Ca = 3 G, i.e. 18.75 G, would mix "
         "the two moduli.) The theory holds for D << 1; the membrane softens in the neo-Hookean law "
         "at finite strain and the computed D falls below the line as G grows.",

@@ -144,7 +144,7 @@ FarutinFit farutin_fit_point(const Vec3& x0, const Vec3& normal_guess, std::span
   fit.normal = (fit.n0 - a * fit.t1 - b * fit.t2) / w;
   // E = 1 + a^2, F = ab, G = 1 + b^2, EG - F^2 = W^2; L, M, N = h_uu / W, h_uv / W, h_vv / W.
   // The textbook (EN - 2FM + GL) / (2(EG - F^2)) is negative on a sphere with the outward normal
-  // (the surface bends away from n); CONVENTIONS.md wants H = 1/R there, hence the minus sign.
+  // (the surface bends away from n); docs/conventions.md wants H = 1/R there, hence the minus sign.
   fit.H = -((1 + b * b) * c[2] - 2 * a * b * c[3] + (1 + a * a) * c[4]) / (2 * w2 * w);
   fit.K = (c[2] * c[4] - c[3] * c[3]) / (w2 * w2);
 

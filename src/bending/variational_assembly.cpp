@@ -9,7 +9,7 @@ BendingResult assemble_variational_result(Points normal, Scalars H, Scalars K, S
   r.force_density.resize(n, 3);
   r.force.resize(n, 3);
   for (Eigen::Index i = 0; i < n; ++i) {
-    // eq. (10) with Lap = div grad (CONVENTIONS.md section 1).
+    // eq. (10) with Lap = div grad (docs/conventions.md §1).
     const double fn = 2.0 * kappa_b * (lapH[i] + 2.0 * H[i] * (H[i] * H[i] - K[i]));
     r.force_density.row(i) = fn * normal.row(i);
     r.force.row(i) = area[i] * r.force_density.row(i);  // eq. (14)

@@ -48,7 +48,7 @@ TEST(RbcStudy, TinyStudyGivesEveryRowWithFiniteErrors) {
   o.progress = [&](const std::string&) { ++lines; };
   const RbcStudyResult r = run_rbc_study(o);
 
-  // Denominators of eq. (17) for R = 1, kB = 1 (CONVENTIONS.md section 3).
+  // Denominators of eq. (17) for R = 1, kB = 1 (docs/conventions.md §3).
   EXPECT_NEAR(r.maxima.H, 2.20098, 1e-4);
   EXPECT_NEAR(r.maxima.f, 189.457, 1e-2);
 

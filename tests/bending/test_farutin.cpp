@@ -154,7 +154,7 @@ TEST(FarutinFit, EqualsThreeComponentFit) {
   const double l = xuu.dot(n), mm = xuv.dot(n), nn = xvv.dot(n);
   const double h_textbook = (e * nn - 2 * f * mm + g * l) / (2 * (e * g - f * f));
   const double k = (l * nn - mm * mm) / (e * g - f * f);
-  EXPECT_NEAR(fit.H, -h_textbook, 1e-10);  // CONVENTIONS.md: the opposite sign of the textbook formula
+  EXPECT_NEAR(fit.H, -h_textbook, 1e-10);  // docs/conventions.md: the opposite sign of the textbook formula
   EXPECT_NEAR(fit.K, k, 1e-10);
   EXPECT_NEAR((fit.normal - n).norm(), 0.0, 1e-12);
 }

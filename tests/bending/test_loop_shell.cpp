@@ -214,7 +214,7 @@ TEST(LoopShell, SphereResultIsNearlyExact) {
 }
 
 TEST(LoopShell, ForceDensityHasTheConventionalSignOnTheRbc) {
-  // CONVENTIONS.md: f = 2 kB (lapH + 2 H (H^2 - K)) n. A sign error would give eps_f near 2.
+  // docs/conventions.md: f = 2 kB (lapH + 2 H (H^2 - K)) n. A sign error would give eps_f near 2.
   const TriMesh m = sphere_mesh(MeshFamily::MT1, 3);
   const auto rbc = make_rbc();
   const Points x = rbc->map_from_unit_sphere(m.positions());

@@ -144,7 +144,7 @@ TEST(Meyer, ScalingAndRotation) {
   EXPECT_LT((rr.force_density - r.force_density * Q.transpose()).rowwise().norm().maxCoeff(), 1e-11 * fmax);
 }
 
-// The 5120-triangle RBC (CONVENTIONS.md section 4): sign of f against the analytic f where the
+// The 5120-triangle RBC (docs/conventions.md §4): sign of f against the analytic f where the
 // latter is not small, and the average relative error of H, eq. (17).
 TEST(Meyer, RedBloodCell5120) {
   const auto a = test_support::rbc_agreement_5120(MeyerMethod(), "Meyer");

@@ -21,7 +21,7 @@ struct Case {
   TriMesh mesh;
 };
 
-// Every family of CONVENTIONS.md section 4, on the sphere and mapped to the RBC: the RBC and
+// Every family of docs/conventions.md §4, on the sphere and mapped to the RBC: the RBC and
 // Rivara meshes contain obtuse triangles, which is where the mixed area differs from Voronoi.
 std::vector<Case> all_families() {
   std::vector<Case> cases;

@@ -108,7 +108,7 @@ TEST(Rbc, ReproducesReferencePoints) {
 }
 
 TEST(Rbc, MaximaMatchStatedValues) {
-  // CONVENTIONS.md section 3 states them to 6 significant digits (R = 1, kB = 1).
+  // docs/conventions.md §3 states them to 6 significant digits (R = 1, kB = 1).
   const SurfaceMaxima m = make_rbc(1.0)->maxima();
   EXPECT_NEAR(m.H, 2.20098, 0.5e-5);
   EXPECT_NEAR(m.K, 3.60620, 0.5e-5);

@@ -1,5 +1,5 @@
 #pragma once
-// Error measures of the paper's eq. (17), CONVENTIONS.md section 3.
+// Error measures of the paper's eq. (17), docs/conventions.md §3.
 //
 // Per node i, with analytic (a) and numerical (n) values:
 //   eps_n    = |n_a - n_n|                        (|n_a| = 1, so already relative)

@@ -2,7 +2,7 @@
 // Method D (paper section 2.4.2): Method C with the Laplace-Beltrami operator replaced by Belkin
 // et al.'s heat-kernel discretization, eq. (13).
 //
-// The operator, with the div-grad sign of CONVENTIONS.md (the paper writes w(x_i) - w(p)):
+// The operator, with the div-grad sign of docs/conventions.md (the paper writes w(x_i) - w(p)):
 //
 //   (Lap w)_i = 1/(4 pi a_i^2) sum_t A_t/3 sum_{p in V(t)} exp(-|p - x_i|^2 / (4 a_i)) (w(p) - w(x_i))
 //

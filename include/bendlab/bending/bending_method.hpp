@@ -2,7 +2,7 @@
 // The one small interface every bending algorithm implements (paper table 1).
 //
 // Given a mesh (topology + positions) and the bending modulus kB, a method returns per-vertex
-// arrays in vertex order. Signs follow CONVENTIONS.md:
+// arrays in vertex order. Signs follow docs/conventions.md:
 //   H > 0 on a sphere, lapH = div grad H, f = 2 kB (lapH + 2 H (H^2 - K)) n  (eq. (10)),
 //   F = -dE/dx for energy-based methods, and F = f * A_mixed, f = F / A_mixed (eq. (14)).
 // Quantities a method does not define are NaN (e.g. H, K, lapH for Method A).

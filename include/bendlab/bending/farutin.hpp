@@ -1,7 +1,7 @@
 #pragma once
 // Method E (Farutin et al.; paper section 2.4.3): least-squares paraboloids on a node's
 // neighbourhood give the normal, H, K and, from a second paraboloid fitted to H, Lap H; then
-// f = 2 kB (Lap H + 2 H (H^2 - K)) n, eq. (10), with the signs of CONVENTIONS.md.
+// f = 2 kB (Lap H + 2 H (H^2 - K)) n, eq. (10), with the signs of docs/conventions.md.
 //
 // The fit at node i, in the local frame (t1, t2, n0) with n0 the MWA normal and
 // (u, v) = ((x_j - x_i) . t1, (x_j - x_i) . t2):

@@ -14,7 +14,7 @@
 //      solver=cg (default; Jacobi-preconditioned CG to a relative residual of 1e-10,
 //      loop_shell_solve.hpp, warm-started from the previous solution on the same topology) or solver=ldlt (sparse LDL^T whose symbolic analysis is kept per
 //      topology; exact, but its fill-in makes it about 10x slower at 20480 triangles). Then f = sum_J N_J f_c,J is the density whose
-//      weak form int f . dx dA = -dE_B; its sign is that of CONVENTIONS.md,
+//      weak form int f . dx dA = -dE_B; its sign is that of docs/conventions.md,
 //      f = 2 kB (lapH + 2 H (H^2 - K)) n.
 //   4. nodal values at the limit point of node i: f_i = sum_J L_iJ f_c,J, n_i from the tangent
 //      masks, H_i and K_i from the limit surface at the node (option H=limit, default) or

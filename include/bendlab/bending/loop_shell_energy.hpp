@@ -6,7 +6,7 @@
 // With theta = (v, w) and I over a patch's control points P_I:
 //   a_alpha = sum N_I,alpha P_I, metric a_ab = a_a . a_b, dual a^a = a^ab a_b,
 //   J = |a_1 x a_2|, n = a_1 x a_2 / J (outward: patches are counter-clockwise),
-//   b_ab = n . x_,ab, H = -1/2 a^ab b_ab (> 0 on a sphere, CONVENTIONS.md), K = det b / det a;
+//   b_ab = n . x_,ab, H = -1/2 a^ab b_ab (> 0 on a sphere, docs/conventions.md), K = det b / det a;
 //   dJ/dP_I = J N_I,a a^a,
 //   dH/dP_I = b^ab N_I,b a_a - 1/2 a^ab (N_I,ab - Gamma^g_ab N_I,g) n, Gamma^g_ab = a^g . x_,ab,
 //   dE_B/dP_I = 2 kB sum_T sum_q w_q [2 H J dH/dP_I + H^2 dJ/dP_I],

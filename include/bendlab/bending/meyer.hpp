@@ -7,7 +7,7 @@
 //                  a_i = A_mixed_i (positive on a sphere);
 //   lapH_i       : eq. (11) applied again, to H;
 //   K_i          : angle defect over the mixed area, eq. (12);
-//   f_i          : eq. (10), f = 2 kB (lapH + 2 H (H^2 - K)) n (CONVENTIONS.md sign);
+//   f_i          : eq. (10), f = 2 kB (lapH + 2 H (H^2 - K)) n (docs/conventions.md sign);
 //   F_i          : f_i A_mixed_i, eq. (14); area = A_mixed.
 // The paper writes eq. (11) as sum T_ij (w_i - w_j); here the Laplacian is div grad
 // (sum T_ij (w_j - w_i)), the sign with which eq. (10) holds. Method C has no energy. The last step,

@@ -1,5 +1,5 @@
 #pragma once
-// Shape diagnostics of a capsule (paper section 4.1, CONVENTIONS.md section 2): the ellipsoid with
+// Shape diagnostics of a capsule (paper section 4.1, docs/conventions.md §2): the ellipsoid with
 // the same inertia tensor as the enclosed volume, its Taylor deformation D = (a - c)/(a + c) and
 // its inclination theta in the shear plane (x-z; u_inf = gamma z e_x).
 //

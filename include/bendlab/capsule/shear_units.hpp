@@ -1,5 +1,5 @@
 #pragma once
-// Units of the capsule in linear shear flow u_inf = gamma z e_x (paper section 4, CONVENTIONS.md
+// Units of the capsule in linear shear flow u_inf = gamma z e_x (paper section 4, docs/conventions.md
 // section 2): R = 1 (initial radius), mu = 1 (viscosity), gamma = 1 (shear rate), so time is
 // gamma t and
 //   G           = mu gamma R / kS         (capillary number)   =>  kS = 1 / G

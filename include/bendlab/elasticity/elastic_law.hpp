@@ -20,7 +20,7 @@ class ElasticLaw {
   virtual ~ElasticLaw() = default;
   /// "neo-Hookean", ...
   virtual std::string name() const = 0;
-  /// The in-plane modulus kS of the law (CONVENTIONS.md section 2).
+  /// The in-plane modulus kS of the law (docs/conventions.md §2).
   virtual double kS() const = 0;
   virtual const Topology& topology() const = 0;
   /// E_S for node positions x (N x 3).

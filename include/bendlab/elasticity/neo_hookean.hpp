@@ -20,7 +20,7 @@ namespace bendlab {
 
 class NeoHookean final : public ElasticLaw {
  public:
-  /// kS: the modulus of eq. (18) (three times the shear modulus, CONVENTIONS.md section 2).
+  /// kS: the modulus of eq. (18) (three times the shear modulus, docs/conventions.md §2).
   /// Throws bendlab::Error for a reference triangle of zero area or a non-positive kS.
   NeoHookean(TopologyPtr topology, const Points& reference, double kS);
 

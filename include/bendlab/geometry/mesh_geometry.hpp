@@ -2,7 +2,7 @@
 // Discrete differential geometry of flat triangles, computed in one pass for one set of positions
 // and kept together so that every bending method reads the same numbers.
 //
-// Conventions (see CONVENTIONS.md of the specification):
+// Conventions (see docs/conventions.md of the specification):
 // - face normals are unit and outward (faces counter-clockwise seen from outside);
 // - corner k of face f is at vertex faces(f, k); corner_angle(f, k) in (0, pi);
 // - edge_cot_weight(e) = T_ij = cot(theta_1) + cot(theta_2), the cotangents of the two corners

@@ -1,5 +1,5 @@
 #pragma once
-// The mesh families of the paper (CONVENTIONS.md section 4), all on the unit sphere; maps to other
+// The mesh families of the paper (docs/conventions.md §4), all on the unit sphere; maps to other
 // shapes live with the analytic surfaces (bendlab/surfaces).
 //
 //   MT1:  icosahedron, k Loop subdivision steps (Loop's rules for the new edge points and for the
@@ -45,7 +45,7 @@ TriMesh refine_midpoint(const TriMesh& mesh, bool project_to_unit_sphere = true)
 /// the result is deterministic; old nodes keep their indices, new nodes are appended. The sphere
 /// meshes have many equal edges, and the count after three passes depends on how ties are broken:
 /// from the 320-triangle meshes this gives 4880 (MT1) and 3680 (MT2) triangles, the paper 3914 and
-/// 3848 (CONVENTIONS.md section 4).
+/// 3848 (docs/conventions.md §4).
 TriMesh rivara_pass(const TriMesh& mesh, bool project_to_unit_sphere = true);
 
 /// The refinement level k whose mesh of `family` has exactly `triangles` triangles

@@ -1,7 +1,7 @@
 #pragma once
 // Analytic reference surfaces (sphere, spheroid, RBC) and their exact differential geometry.
 //
-// Conventions (CONVENTIONS.md): outward unit normal n; H = (c1 + c2) / 2 > 0 on a sphere;
+// Conventions (docs/conventions.md): outward unit normal n; H = (c1 + c2) / 2 > 0 on a sphere;
 // K = c1 c2; lapH = div_S grad_S H; f = 2 kB (lapH + 2 H (H^2 - K)) n (eq. (10)).
 // All surfaces are surfaces of revolution about the z axis, centred at the origin.
 #include <memory>

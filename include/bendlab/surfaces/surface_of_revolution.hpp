@@ -10,7 +10,7 @@
 //
 // Writing the curve this way makes z'(t) = sin t * B(t) with B = -Z + 2 cos^2 t Z'(w) explicitly,
 // so the azimuthal curvature -z' / (r s') = -B / (A s') needs no division by r = 0 at the poles.
-// Signs (CONVENTIONS.md): outward normal, H = (c1 + c2)/2 > 0 on a sphere, lapH = div_S grad_S H.
+// Signs (docs/conventions.md): outward normal, H = (c1 + c2)/2 > 0 on a sphere, lapH = div_S grad_S H.
 #include <mutex>
 #include <vector>
 

@@ -2,7 +2,7 @@
 // The boundary integral method for a capsule in linear shear flow (paper section 4), one
 // CapsuleSolver. The node velocity is a function of the positions alone, eq. (23):
 //   1. f = the membrane model's force density (F / A_mixed, eq. (14));
-//   2. u = u_inf + single layer of f (eq. (22), sign of CONVENTIONS.md), u_inf = gamma z e_x;
+//   2. u = u_inf + single layer of f (eq. (22), sign of docs/conventions.md), u_inf = gamma z e_x;
 //   3. u projected onto the zero discrete flux hyperplane (volume_correction.hpp);
 // advanced by an adaptive Integrator (Cash-Karp 4(5) by default, section 4.3.1). After every
 // accepted step the shape is rescaled about its volume centroid to the reference volume.

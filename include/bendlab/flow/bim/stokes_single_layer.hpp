@@ -1,6 +1,6 @@
 #pragma once
 // Stokes single-layer potential on a closed surface of flat triangles: the integral of the
-// boundary integral equation (22), with the sign of CONVENTIONS.md section 1 (traction jump
+// boundary integral equation (22), with the sign of docs/conventions.md §1 (traction jump
 // Delta f^h = -f):
 //
 //   u_j(x_i) = 1/(8 pi mu) oint_S f_k(y) G_kj(y, x_i) dS(y),  G_kj = delta_kj / r + r_k r_j / r^3,

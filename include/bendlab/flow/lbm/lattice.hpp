@@ -13,7 +13,7 @@
 //
 // Geometry: nx x ny x nz nodes, node (i, j, k) at the physical position
 // (i + 1/2 - nx/2, j + 1/2 - ny/2, k + 1/2 - nz/2): the box is centred on the origin, where the
-// capsule sits (CONVENTIONS.md). x and y are periodic. With walls, flat walls lie halfway between
+// capsule sits (docs/conventions.md). x and y are periodic. With walls, flat walls lie halfway between
 // the outermost nodes and the (absent) next ones, at z = -nz/2 (moving with -v e_x) and z = +nz/2
 // (moving with +v e_x): link bounce-back with wall velocity (Ladd), pull form
 //   f_i(x, t+1) = f_ibar*(x, t) + 6 w_i rho0 c_i.u_w   where x - c_i lies in the wall,
