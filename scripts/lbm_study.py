@@ -130,6 +130,15 @@ def read_json(path):
         return None
 
 
+def read_summary(folder):
+    """summary.json of a finished run, with its wall time from timing.json (NaN where absent)."""
+    s = read_json(folder / "summary.json")
+    if s is not None:
+        timing = read_json(folder / "timing.json") or {}
+        s["wall_seconds"] = float(timing.get("wall_seconds", s.get("wall_seconds", math.nan)))
+    return s
+
+
 def lbm_matches(args, run):
     try:
         return (args.get("solver") == "lbm" and args.get("method") == run.method
@@ -141,7 +150,7 @@ def lbm_matches(args, run):
 
 
 def finished_summary(folder, run):
-    s = read_json(folder / "summary.json")
+    s = read_summary(folder)
     if s is not None and close(s.get("t_end"), run.t_end) and (
             lbm_matches(s, run) if isinstance(run, LbmRun) else
             (s.get("method") == run.method and close(s.get("G"), run.G) and close(s.get("kappa_b_hat"), run.kappa_b))):
@@ -208,7 +217,7 @@ def measure_cost(runs, work, bendlab, steps):
         rc = launch([str(bendlab)] + probe.arguments(folder, t_end=t_end), folder, False)
         wall, cpu1 = time.monotonic() - start, os.times()
         cpu = (cpu1.children_user - cpu0.children_user) + (cpu1.children_system - cpu0.children_system)
-        s = read_json(folder / "summary.json")
+        s = read_summary(folder)
         if rc != 0 or s is None:
             print(f"cost probe {key} failed (exit {rc}); see {folder / 'run.log'}", file=sys.stderr)
             continue

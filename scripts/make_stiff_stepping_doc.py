@@ -52,6 +52,10 @@ def load(folder):
     if finished:
         with open(summary_path) as f:
             s = json.load(f)
+        timing_path = os.path.join(folder, "timing.json")
+        if os.path.exists(timing_path):  # the wall time lives beside the results
+            with open(timing_path) as f:
+                s["wall_seconds"] = json.load(f).get("wall_seconds")
     else:  # a run still going: its identity and counters from the checkpoint
         with open(os.path.join(folder, "checkpoint.json")) as f:
             c = json.load(f)

@@ -177,10 +177,15 @@ _steady_windows = {}
 
 
 def read_summary(path):
+    """summary.json, with the run's wall time from timing.json beside it (NaN where absent)."""
     try:
         summary = json.loads(path.read_text())
     except (OSError, ValueError):
         return None
+    try:
+        summary["wall_seconds"] = float(json.loads((path.parent / "timing.json").read_text())["wall_seconds"])
+    except (OSError, ValueError, KeyError, TypeError):
+        summary.setdefault("wall_seconds", math.nan)
     try:
         _steady_windows[float(summary["t_end"])] = [float(x) for x in summary["steady_window"]]
     except (KeyError, TypeError, ValueError):

@@ -1,5 +1,7 @@
 #include "bendlab/bending/farutin.hpp"
 
+#include <fmt/format.h>
+
 #include <cmath>
 #include <limits>
 
@@ -199,6 +201,15 @@ std::vector<FarutinFit> farutin_fit(const Topology& t, const Points& x, const Po
   return fits;
 }
 
+void require_valid_fits(const std::vector<FarutinFit>& fits, std::string_view method) {
+  for (std::size_t i = 0; i < fits.size(); ++i)
+    if (!fits[i].valid())
+      throw Error(fmt::format("method {}: no paraboloid fits the neighbourhood of vertex {}, even with every vertex "
+                              "the mesh connects to it (the least-squares system is singular); the mesh is too "
+                              "coarse or too symmetric for the fits: refine it",
+                              method, i));
+}
+
 Scalars farutin_laplacian(const Topology& t, const Points& x, const std::vector<FarutinFit>& fits, const Scalars& w) {
   const int n = t.num_vertices();
   Scalars out(n);
@@ -262,6 +273,7 @@ MethodInfo FarutinMethod::info() {
 BendingResult FarutinMethod::compute(const Topology& topology, const Points& x, double kappa_b) const {
   const MeshGeometry geometry = MeshGeometry::compute(topology, x);
   const std::vector<FarutinFit> fits = farutin_fit(topology, x, geometry.normal_mwa, rings_);
+  require_valid_fits(fits, "E");
   FarutinFields e = farutin_fields(fits);
   Scalars lapH = farutin_laplacian(topology, x, fits, e.H);
   return assemble_variational_result(std::move(e.normal), std::move(e.H), std::move(e.K), std::move(lapH),

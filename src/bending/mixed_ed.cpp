@@ -24,7 +24,9 @@ MethodInfo MixedEDMethod::info() {
 
 BendingResult MixedEDMethod::compute(const Topology& topology, const Points& x, double kappa_b) const {
   const MeshGeometry geometry = MeshGeometry::compute(topology, x);
-  FarutinFields e = farutin_fields(farutin_fit(topology, x, geometry.normal_mwa, rings_));
+  const std::vector<FarutinFit> fits = farutin_fit(topology, x, geometry.normal_mwa, rings_);
+  require_valid_fits(fits, "ED");
+  FarutinFields e = farutin_fields(fits);
   Scalars lapH = belkin_laplacian(topology, x, geometry, e.H);
   return assemble_variational_result(std::move(e.normal), std::move(e.H), std::move(e.K), std::move(lapH),
                                      geometry.mixed_area, kappa_b);

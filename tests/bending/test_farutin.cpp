@@ -6,9 +6,11 @@
 #include <cmath>
 #include <cstdio>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "bendlab/bending/farutin.hpp"
+#include "bendlab/bending/mixed_ed.hpp"
 #include "bendlab/geometry/mesh_geometry.hpp"
 #include "bendlab/mesh/generators.hpp"
 #include "bendlab/surfaces/analytic_surface.hpp"
@@ -284,6 +286,26 @@ TEST(Farutin, LargerRingsAndLowValence) {
   const BendingResult r = FarutinMethod().compute(octa.topology(), octa.positions(), 1.0);
   EXPECT_TRUE(r.force.allFinite());
   for (int i = 0; i < octa.num_vertices(); ++i) EXPECT_NEAR(r.H[i], 1.0, 0.1);
+}
+
+TEST(Farutin, MeshWithoutAnyValidFitIsRefusedNamingTheVertex) {
+  // The bare octahedron: every vertex sees the four at distance sqrt(2) and the opposite one on
+  // its own normal line, so the xy coefficient of the paraboloid is free at every support size.
+  // E and ED refuse it with a named error instead of returning NaN forces.
+  const TriMesh octa = octahedron();
+  for (const bool mixed : {false, true}) {
+    try {
+      if (mixed)
+        (void)MixedEDMethod().compute(octa.topology(), octa.positions(), 1.0);
+      else
+        (void)FarutinMethod().compute(octa.topology(), octa.positions(), 1.0);
+      ADD_FAILURE() << "the octahedron was accepted";
+    } catch (const Error& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find(mixed ? "method ED" : "method E"), std::string::npos) << what;
+      EXPECT_NE(what.find("vertex 0"), std::string::npos) << what;
+    }
+  }
 }
 
 TEST(Farutin, IndependentOfThreadCount) {

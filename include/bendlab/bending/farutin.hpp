@@ -22,6 +22,7 @@
 // With the height form: g = I + grad h grad h^T, Gamma^c_ab = h_ab h_c / W^2, W^2 = 1 + |grad h|^2.
 #include <memory>
 #include <span>
+#include <string_view>
 #include <vector>
 
 #include "bendlab/bending/method_registry.hpp"
@@ -61,6 +62,11 @@ double farutin_laplacian_point(const FarutinFit& fit, const Vec3& x0, std::span<
 /// The fit at every node, normal_guess the MWA normals; rings >= 1 (see the neighbourhood rule).
 std::vector<FarutinFit> farutin_fit(const Topology& topology, const Points& x, const Points& normal_guess,
                                     int rings);
+
+/// Throws bendlab::Error naming `method` and the first vertex whose fit is invalid: no support
+/// the mesh offers determines its paraboloid (the bare octahedron, for instance, where every
+/// neighbourhood is symmetric enough to leave the xy term free). Called before any further work.
+void require_valid_fits(const std::vector<FarutinFit>& fits, std::string_view method);
 
 /// Lap w at every node on the neighbourhoods and charts of `fits` (NaN where a fit is invalid).
 Scalars farutin_laplacian(const Topology& topology, const Points& x, const std::vector<FarutinFit>& fits,

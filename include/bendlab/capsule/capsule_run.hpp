@@ -4,13 +4,14 @@
 //   timeseries.csv   one row per accepted step (time_series.hpp), append-only, flushed per row
 //   snapshot_NNNNN.vtp + shapes.pvd   the shape every snapshot_every (and at t_end)
 //   checkpoint.json  the state at the last snapshot (checkpoint.hpp), for resume
-//   summary.json     the arguments, the steady statistics (steady_statistics.hpp), counters,
-//                    volumes and wall_seconds
+//   summary.json     the arguments, the steady statistics (steady_statistics.hpp), counters
+//                    and volumes: results only, no clock
+//   timing.json      wall_seconds of all parts, wall_seconds_last_part, resumed
 //
 // A resumed run (options.resume) validates checkpoint.json as a whole, checks that its arguments
 // equal options.arguments, truncates timeseries.csv to the checkpoint's rows (atomic rewrite),
-// restores the solver and continues; its summary.json then equals the uninterrupted run's exactly,
-// except "wall_seconds" (the wall time of all parts; a clock, not a result). If t_end changed so
+// restores the solver and continues; its summary.json then equals the uninterrupted run's exactly
+// (the wall time is in timing.json, which does not). If t_end changed so
 // that the steady window moved, the window's sums are recomputed from timeseries.csv (to the
 // precision of the file: dt has 6 digits, so about 1e-6 relative) and a note says so.
 //
@@ -62,6 +63,7 @@ struct CapsuleRunOptions {
 struct CapsuleRunResult {
   bool finished = false;   ///< reached t_end (false: stopped by stop_after_steps)
   nlohmann::json summary;  ///< summary.json's content (when finished)
+  double wall_seconds = 0; ///< wall time of all parts of the run (timing.json; when finished)
 };
 
 /// The time-series row of positions x at time t after a step dt: D and theta of the equivalent
