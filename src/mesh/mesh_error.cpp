@@ -8,6 +8,7 @@ const char* to_string(MeshProblem p) {
     case MeshProblem::RepeatedIndex: return "repeated index";
     case MeshProblem::ZeroArea: return "zero-area triangle";
     case MeshProblem::NonFinite: return "non-finite coordinate";
+    case MeshProblem::OutOfRange: return "coordinates out of range";
     case MeshProblem::NonManifoldEdge: return "non-manifold edge";
     case MeshProblem::NonManifoldVertex: return "non-manifold vertex";
     case MeshProblem::BoundaryEdge: return "boundary edge";

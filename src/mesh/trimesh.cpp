@@ -15,6 +15,24 @@ void validate_geometry(const Topology& topology, const Points& x) {
     if (!x.row(i).allFinite())
       throw MeshError(MeshProblem::NonFinite,
                       fmt::format("vertex {} has coordinates ({}, {}, {})", i, x(i, 0), x(i, 1), x(i, 2)));
+  // Areas scale with the square and volumes with the cube of the coordinates, and the squared norms
+  // of area vectors with the fourth power (1e60^4 = 1e240, leaving room for the moduli): outside these bounds
+  // they over- or underflow double precision and later checks would misname the problem.
+  constexpr double kLargestCoordinate = 1e60, kSmallestExtent = 1e-60;
+  if (x.rows() > 0) {
+    const double largest = x.cwiseAbs().maxCoeff();
+    const double extent = (x.colwise().maxCoeff() - x.colwise().minCoeff()).maxCoeff();
+    if (largest > kLargestCoordinate)
+      throw MeshError(MeshProblem::OutOfRange,
+                      fmt::format("the largest coordinate magnitude {:.3g} exceeds {:.0e}, where areas and volumes "
+                                  "overflow: rescale the mesh",
+                                  largest, kLargestCoordinate));
+    if (extent < kSmallestExtent)
+      throw MeshError(MeshProblem::OutOfRange,
+                      fmt::format("the mesh extends only {:.3g} (below {:.0e}), where areas and volumes underflow: "
+                                  "rescale the mesh",
+                                  extent, kSmallestExtent));
+  }
   const Faces& F = topology.faces();
   for (int f = 0; f < topology.num_faces(); ++f) {
     const Vec3 a = x.row(F(f, 0)), b = x.row(F(f, 1)), c = x.row(F(f, 2));

@@ -96,6 +96,11 @@ TEST(MeshValidation, RefusesEachProblemByName) {
     p(3, 2) = std::numeric_limits<double>::quiet_NaN();
     TriMesh(p, tetra_faces());
   });
+  // A scaled tetrahedron is a valid mesh at every scale where its areas and volume are
+  // representable; beyond that it is refused as out of range, not as inward or zero-area.
+  for (const double scale : {1e-50, 1e50}) EXPECT_NO_THROW(TriMesh(Points(scale * tetra_points()), tetra_faces()));
+  expect_problem(MeshProblem::OutOfRange, [] { TriMesh(Points(1e80 * tetra_points()), tetra_faces()); });
+  expect_problem(MeshProblem::OutOfRange, [] { TriMesh(Points(1e-80 * tetra_points()), tetra_faces()); });
   expect_problem(MeshProblem::ZeroArea, [] {
     Points p = tetra_points();
     p.row(3) = p.row(1);  // faces touching vertices 1 and 3 collapse to a segment

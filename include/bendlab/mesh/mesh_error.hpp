@@ -11,6 +11,7 @@ enum class MeshProblem {
   RepeatedIndex,            ///< a face names the same vertex twice
   ZeroArea,                 ///< a triangle with (numerically) zero area
   NonFinite,                ///< a coordinate that is NaN or infinite
+  OutOfRange,               ///< coordinates so large or a mesh so small that areas or volumes over/underflow
   NonManifoldEdge,          ///< an edge shared by more than two faces
   NonManifoldVertex,        ///< the faces around a vertex form more than one fan
   BoundaryEdge,             ///< an edge with one face: the surface is open
