@@ -1,0 +1,68 @@
+#pragma once
+// LbmCapsuleSolver (flow/lbm/lbm_capsule_solver.hpp) over the ranks of an MPI communicator: the
+// fluid is a DistributedLattice (y-slabs), the membrane is whole on every rank. Same options,
+// same steps, same reports, same checkpoints (name "lbm", the same solver_state fields and fluid
+// file), so a run may be resumed with another rank count or by the serial solver.
+//
+// The membrane across ranks (docs/mpi.md): every rank holds all membrane nodes and computes their
+// forces itself (the same positions give the same forces on every rank: no communication, the
+// force evaluation is repeated ranks times, which is small next to the fluid for the paper's
+// meshes); each rank spreads every node's force onto its own layers only (the serial order of
+// the sums per lattice node, so the force field is the serial one bit for bit) and interpolates
+// from its own layers only; the partial velocities (3N doubles) are summed on rank 0
+// (MPI_Reduce) and broadcast (MPI_Bcast), so every rank moves the nodes to the same positions.
+// A node whose kernel lies on one rank gets the serial velocity exactly; one whose kernel
+// straddles two slabs gets it summed in another order (a rounding difference, 1e-16 relative).
+// Communication per step: the halo (slab_decomposition.hpp) plus 2 x 3N doubles.
+//
+// Every member that steps, saves, restores or checks the fluid is collective; an error (blow-up,
+// a node reaching a wall, a failed file) is thrown on every rank alike.
+#include <mpi.h>
+
+#include <cstdint>
+#include <memory>
+
+#include "bendlab/capsule/capsule_solver.hpp"
+#include "bendlab/flow/lbm/lbm_capsule_solver.hpp"
+#include "bendlab/parallel/distributed_lattice.hpp"
+
+namespace bendlab::parallel {
+
+class MpiLbmCapsuleSolver final : public CapsuleSolver {
+ public:
+  static constexpr std::int64_t kFluidCheckSteps = LbmCapsuleSolver::kFluidCheckSteps;
+
+  /// As LbmCapsuleSolver's constructor (the same errors), on the ranks of `comm` (collective).
+  MpiLbmCapsuleSolver(std::shared_ptr<const MembraneModel> membrane, LbmSolverOptions options, MPI_Comm comm);
+
+  std::string name() const override { return "lbm"; }
+  const MembraneModel& membrane() const override { return *membrane_; }
+  const Points& positions() const override { return x_; }
+  double time() const override { return static_cast<double>(fluid_.step_count()) * gamma_; }
+  bool advance(double t_end, const OnStep& on_step) override;
+  SolverCounters counters() const override { return counters_; }
+  SolverState save_state(const std::filesystem::path& folder, const std::string& tag) const override;
+  void restore_state(const Points& positions, double time, const SolverCounters& counters,
+                     const nlohmann::json& fields, const std::filesystem::path& folder,
+                     const std::string& source) override;
+
+  void step();
+
+  const DistributedLattice& fluid() const { return fluid_; }
+  const Points& lattice_positions() const { return X_; }
+  std::int64_t sample_steps() const { return sample_steps_; }
+
+ private:
+  void check_fluid() const;
+
+  std::shared_ptr<const MembraneModel> membrane_;
+  LbmSolverOptions options_;
+  DistributedLattice fluid_;
+  double gamma_ = 0, force_scale_ = 0;
+  std::int64_t sample_steps_ = 1;
+  Points X_, x_, F_, U_, Usum_;
+  SolverCounters counters_;
+  std::int64_t last_fluid_check_ = 0;
+};
+
+}  // namespace bendlab::parallel
