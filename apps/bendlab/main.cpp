@@ -4,6 +4,7 @@
 // its message (naming the rank) and ends every rank with MPI_Abort (docs/mpi.md).
 #include <fmt/format.h>
 
+#include <cstdio>
 #include <cstdlib>
 #include <iostream>
 #ifdef BENDLAB_HAVE_MPI
@@ -97,7 +98,10 @@ int main(int argc, char** argv) {
     return e.get_exit_code();
   } catch (const std::exception& e) {
     // Commands do their work in callbacks, which run inside parse().
-    std::cerr << who << ": error: " << e.what() << std::endl;
+    // One write per line, so that the ranks' lines do not interleave.
+    const std::string line = fmt::format("{}: error: {}\n", who, e.what());
+    std::fputs(line.c_str(), stderr);
+    std::fflush(stderr);
     if (world.size > 1) mpi.abort_all(1);
     return 1;
   }
