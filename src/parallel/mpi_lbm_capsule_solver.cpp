@@ -24,22 +24,6 @@ const std::shared_ptr<const MembraneModel>& checked(const std::shared_ptr<const 
   return m;
 }
 
-// Calls f(local node, weight) for the kernel's nodes of X on this rank's layers, in the serial
-// order (lbm::ib_stencil), skipping zero weights as the serial solver does.
-template <class F>
-void for_owned(const DistributedLattice& d, const Vec3& X, lbm::IbKernel kernel, F&& f) {
-  const lbm::LatticeConfig& g = d.config();
-  const lbm::IbStencil st = lbm::ib_stencil({g.nx, g.ny, g.nz}, g.walls, X, kernel);
-  for (int s = 0; s < st.size; ++s) {
-    if (st.weight[s] == 0.0) continue;
-    const std::size_t node = st.node[s];
-    const int i = static_cast<int>(node % g.nx);
-    const std::size_t r = node / g.nx;
-    const int j = static_cast<int>(r % g.ny), k = static_cast<int>(r / g.ny);
-    if (d.slab().owns(j)) f(d.local_node(i, j, k), st.weight[s]);
-  }
-}
-
 }  // namespace
 
 MpiLbmCapsuleSolver::MpiLbmCapsuleSolver(std::shared_ptr<const MembraneModel> membrane, LbmSolverOptions options,
@@ -91,25 +75,82 @@ void MpiLbmCapsuleSolver::step() {
   try {
     membrane_->forces(x_, F_);
     F_ *= force_scale_;
-    lbm::Lattice& local = fluid_.local();
-    local.clear_force();
-    for (Eigen::Index m = 0; m < X_.rows(); ++m) {
+    const lbm::LatticeConfig& g = fluid_.config();
+    const SlabDecomposition& slab = fluid_.slab();
+    const Eigen::Index N = X_.rows();
+    // The kernel of every node (global indices) and which ranks own its non-zero weights: the
+    // same on every rank, as the positions are.
+    stencils_.resize(static_cast<std::size_t>(N));
+    offsets_.resize(static_cast<std::size_t>(N) + 1);
+    owner_.resize(static_cast<std::size_t>(N));
+    offsets_[0] = 0;
+    auto layer = [&](std::size_t node) { return static_cast<int>((node / g.nx) % g.ny); };
+    auto local = [&](std::size_t node) {
+      const std::size_t r = node / g.nx;
+      return fluid_.local_node(static_cast<int>(node % g.nx), static_cast<int>(r % g.ny), static_cast<int>(r / g.ny));
+    };
+    for (Eigen::Index m = 0; m < N; ++m) {
+      const lbm::IbStencil& st = stencils_[m] = lbm::ib_stencil({g.nx, g.ny, g.nz}, g.walls, row(X_, m), options_.kernel);
+      int lo = slab.ranks, hi = -1;
+      for (int s = 0; s < st.size; ++s) {
+        if (st.weight[s] == 0.0) continue;
+        const int r = slab.owner(layer(st.node[s]));
+        lo = std::min(lo, r);
+        hi = std::max(hi, r);
+      }
+      owner_[m] = lo == hi ? lo : -1;  // -1: the kernel straddles slabs
+      offsets_[m + 1] = offsets_[m] + (owner_[m] >= 0 ? 3 : 3 * st.size);
+    }
+    // Spread onto the owned layers, node by node in the serial order: the serial force field.
+    lbm::Lattice& lat = fluid_.local();
+    lat.clear_force();
+    for (Eigen::Index m = 0; m < N; ++m) {
+      const lbm::IbStencil& st = stencils_[m];
       const Vec3 Fm = row(F_, m);
-      for_owned(fluid_, row(X_, m), options_.kernel, [&](std::size_t node, double w) { local.add_force(node, w * Fm); });
+      for (int s = 0; s < st.size; ++s)
+        if (st.weight[s] != 0.0 && slab.owns(layer(st.node[s]))) lat.add_force(local(st.node[s]), st.weight[s] * Fm);
     }
     fluid_.step();
-    U_.setZero(X_.rows(), 3);
-    for (Eigen::Index m = 0; m < X_.rows(); ++m) {
+    // Interpolate: a node within one slab is summed by its owner as in the serial solver; for a
+    // node whose kernel straddles slabs each rank sends its terms, and every rank sums them in the
+    // serial order. Sums over ranks add zeros only, so every node's velocity is the serial one bit
+    // for bit.
+    terms_.assign(static_cast<std::size_t>(offsets_[N]), 0.0);
+    for (Eigen::Index m = 0; m < N; ++m) {
+      const lbm::IbStencil& st = stencils_[m];
+      double* t = terms_.data() + offsets_[m];
+      if (owner_[m] >= 0) {
+        if (owner_[m] != slab.rank) continue;
+        Vec3 u = Vec3::Zero();
+        for (int s = 0; s < st.size; ++s)
+          if (st.weight[s] != 0.0) u += st.weight[s] * lat.velocity(local(st.node[s]));
+        for (int d = 0; d < 3; ++d) t[d] = u[d];
+      } else {
+        for (int s = 0; s < st.size; ++s)
+          if (st.weight[s] != 0.0 && slab.owns(layer(st.node[s]))) {
+            const Vec3 term = st.weight[s] * lat.velocity(local(st.node[s]));
+            for (int d = 0; d < 3; ++d) t[3 * s + d] = term[d];
+          }
+      }
+    }
+    sums_.resize(terms_.size());
+    const int count = static_cast<int>(terms_.size());
+    MPI_Reduce(terms_.data(), sums_.data(), count, MPI_DOUBLE, MPI_SUM, 0, fluid_.comm());
+    MPI_Bcast(sums_.data(), count, MPI_DOUBLE, 0, fluid_.comm());
+    U_.resize(N, 3);
+    for (Eigen::Index m = 0; m < N; ++m) {
+      const double* t = sums_.data() + offsets_[m];
       Vec3 u = Vec3::Zero();
-      for_owned(fluid_, row(X_, m), options_.kernel, [&](std::size_t node, double w) { u += w * local.velocity(node); });
+      if (owner_[m] >= 0) {
+        u = Vec3(t[0], t[1], t[2]);
+      } else {
+        const lbm::IbStencil& st = stencils_[m];
+        for (int s = 0; s < st.size; ++s)
+          if (st.weight[s] != 0.0) u += Vec3(t[3 * s], t[3 * s + 1], t[3 * s + 2]);
+      }
       U_.row(m) = u.transpose();
     }
-    // Summed in rank order on rank 0 and broadcast: every rank gets the same bits.
-    Usum_.resize(X_.rows(), 3);
-    const int count = static_cast<int>(U_.size());
-    MPI_Reduce(U_.data(), Usum_.data(), count, MPI_DOUBLE, MPI_SUM, 0, fluid_.comm());
-    MPI_Bcast(Usum_.data(), count, MPI_DOUBLE, 0, fluid_.comm());
-    lbm::euler_move(X_, Usum_, 1.0);
+    lbm::euler_move(X_, U_, 1.0);
   } catch (const Error& e) {
     throw Error(fmt::format("LBM step {}: {}", n, e.what()));
   }

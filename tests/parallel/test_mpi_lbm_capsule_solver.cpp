@@ -79,7 +79,9 @@ TEST(MpiLbmCapsuleSolver, MatchesTheSerialSolverAcrossSlabBoundaries) {
   }
   // The capsule has deformed in the shear: the comparison is not of shapes at rest.
   EXPECT_GT((serial.lattice_positions() - o.radius * mem->reference_positions()).cwiseAbs().maxCoeff(), 1e-3);
-  EXPECT_LE(difference(mpi, serial), 1e-13);
+  // The velocity sums of nodes whose kernel straddles slabs are taken in the serial order: the
+  // capsule and the fluid are the serial ones bit for bit (the acceptance bound is 1e-13).
+  EXPECT_EQ(difference(mpi, serial), 0.0);
   EXPECT_EQ(mpi.time(), serial.time());
   EXPECT_EQ(mpi.counters().velocity_evaluations, serial.counters().velocity_evaluations);
 }
@@ -106,7 +108,7 @@ TEST(MpiLbmCapsuleSolver, CheckpointResumesOnHalfTheRanksAndInTheSerialSolver) {
     serial.step();
     serial_resumed.step();
   }
-  EXPECT_LE((serial_resumed.lattice_positions() - serial.lattice_positions()).cwiseAbs().maxCoeff(), 1e-13);
+  EXPECT_EQ((serial_resumed.lattice_positions() - serial.lattice_positions()).cwiseAbs().maxCoeff(), 0.0);
   // Half the ranks (4 -> 2, 2 -> 1, ...) resume and continue as the serial run.
   const int half = std::max(1, bendlab::test::world_size() / 2);
   const bendlab::test::SubComm sub(half);
@@ -115,7 +117,7 @@ TEST(MpiLbmCapsuleSolver, CheckpointResumesOnHalfTheRanksAndInTheSerialSolver) {
     resumed.restore_state(x, t, mpi.counters(), state.fields, folder.path(), "test");
     EXPECT_EQ(resumed.fluid().step_count(), 51);
     for (int s = 0; s < 49; ++s) resumed.step();
-    EXPECT_LE(difference(resumed, serial), 1e-13);
+    EXPECT_EQ(difference(resumed, serial), 0.0);
   }
   MPI_Barrier(MPI_COMM_WORLD);
 }
@@ -152,9 +154,7 @@ TEST(MpiLbmCapsuleSolver, ShearRunWritesTheSerialRunsFilesOnRankZeroOnly) {
     ASSERT_EQ(a.size(), b.size());
     ASSERT_GT(a.size(), 5u);
     for (std::size_t i = 0; i < a.size(); ++i) {
-      EXPECT_NEAR(a[i].t, b[i].t, 1e-12);
-      EXPECT_NEAR(a[i].D, b[i].D, 1e-10);
-      EXPECT_NEAR(a[i].volume, b[i].volume, 1e-10);
+      EXPECT_EQ(format_time_series_row(a[i]), format_time_series_row(b[i]));
     }
     // The same files, and no temporary ones left behind.
     std::vector<std::string> names_a, names_b;

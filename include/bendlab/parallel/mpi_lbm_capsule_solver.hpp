@@ -5,15 +5,18 @@
 // file), so a run may be resumed with another rank count or by the serial solver.
 //
 // The membrane across ranks (docs/mpi.md): every rank holds all membrane nodes and computes their
-// forces itself (the same positions give the same forces on every rank: no communication, the
-// force evaluation is repeated ranks times, which is small next to the fluid for the paper's
-// meshes); each rank spreads every node's force onto its own layers only (the serial order of
-// the sums per lattice node, so the force field is the serial one bit for bit) and interpolates
-// from its own layers only; the partial velocities (3N doubles) are summed on rank 0
-// (MPI_Reduce) and broadcast (MPI_Bcast), so every rank moves the nodes to the same positions.
-// A node whose kernel lies on one rank gets the serial velocity exactly; one whose kernel
-// straddles two slabs gets it summed in another order (a rounding difference, 1e-16 relative).
-// Communication per step: the halo (slab_decomposition.hpp) plus 2 x 3N doubles.
+// forces itself (the same positions give the same forces on every rank: no communication; the
+// force evaluation is repeated on every rank, small next to the fluid for the paper's meshes, but
+// it does not shrink with the rank count). Each rank spreads every node's force onto its own
+// layers only (the serial order of the sums per lattice node: the serial force field) and
+// interpolates from its own layers only: a node whose kernel lies in one slab is summed by the
+// owner in the serial order; for a node whose kernel straddles slabs every rank contributes its
+// terms w u separately. The buffer (3 doubles per node, 3 per kernel node for straddling ones) is
+// summed on rank 0 (MPI_Reduce: each entry has one non-zero contribution, so the sums are exact)
+// and broadcast; every rank then adds the straddling nodes' terms in the serial order. So the
+// node velocities, positions and the fluid are the serial solver's bit for bit, on every rank.
+// Communication per step: the halo (slab_decomposition.hpp) plus 2 x (3 N + 3 x 8 x straddling
+// nodes) doubles for the phi2 kernel.
 //
 // Every member that steps, saves, restores or checks the fluid is collective; an error (blow-up,
 // a node reaching a wall, a failed file) is thrown on every rank alike.
@@ -21,6 +24,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <vector>
 
 #include "bendlab/capsule/capsule_solver.hpp"
 #include "bendlab/flow/lbm/lbm_capsule_solver.hpp"
@@ -60,7 +64,13 @@ class MpiLbmCapsuleSolver final : public CapsuleSolver {
   DistributedLattice fluid_;
   double gamma_ = 0, force_scale_ = 0;
   std::int64_t sample_steps_ = 1;
-  Points X_, x_, F_, U_, Usum_;
+  Points X_, x_, F_, U_;
+  // Scratch of step(): kernels, owner rank of each node's kernel (-1: straddles slabs), offsets of
+  // its terms in the reduced buffer.
+  std::vector<lbm::IbStencil> stencils_;
+  std::vector<int> owner_;
+  std::vector<Eigen::Index> offsets_;
+  std::vector<double> terms_, sums_;
   SolverCounters counters_;
   std::int64_t last_fluid_check_ = 0;
 };
