@@ -7,11 +7,19 @@ foreach(lib ${BENDLAB_LIBRARY_TARGETS})
   string(REPLACE "bendlab_" "" short ${lib})
   set_target_properties(${lib} PROPERTIES EXPORT_NAME ${short})
 endforeach()
-install(TARGETS ${BENDLAB_LIBRARY_TARGETS} bendlab EXPORT bendlabTargets
+set(bendlab_installed_libraries ${BENDLAB_LIBRARY_TARGETS})
+if(BENDLAB_MPI)
+  set_target_properties(bendlab_parallel PROPERTIES EXPORT_NAME parallel)
+  list(APPEND bendlab_installed_libraries bendlab_parallel)
+  set(parallel_headers_excluded "")
+else()
+  set(parallel_headers_excluded PATTERN parallel EXCLUDE)
+endif()
+install(TARGETS ${bendlab_installed_libraries} bendlab EXPORT bendlabTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
         LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
         INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
-install(DIRECTORY ${PROJECT_SOURCE_DIR}/include/bendlab DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/include/bendlab DESTINATION ${CMAKE_INSTALL_INCLUDEDIR} ${parallel_headers_excluded})
 install(TARGETS bendlab_cli RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 # The CLI finds its plotting scripts in <prefix>/share/bendlab/scripts (core/helper_program.hpp).
 install(FILES ${PROJECT_SOURCE_DIR}/scripts/plot_rbc.py ${PROJECT_SOURCE_DIR}/scripts/plot_shear.py

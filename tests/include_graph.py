@@ -3,6 +3,7 @@
 apps/ must go to a folder that the including file's folder may depend on (docs/design.md, Layout).
 
     core <- mesh <- geometry <- bending <- elasticity/membrane <- capsule <- flow <- analysis <- apps
+    parallel (MPI, optional) sits on flow, beside analysis; only apps include it.
     surfaces depends on core and mesh only; integrate on core, mesh and geometry.
 
 The folder of a file is the first path component below include/bendlab/ or src/ (so flow/bim is
@@ -28,8 +29,11 @@ ALLOWED = {
     "flow": {"core", "mesh", "geometry", "surfaces", "bending", "elasticity", "membrane", "integrate", "capsule"},
     "analysis": {"core", "mesh", "geometry", "surfaces", "bending", "elasticity", "membrane", "integrate",
                  "capsule", "flow"},
+    # MPI domain decomposition of flow/lbm (built only with BENDLAB_MPI; nothing below includes it).
+    "parallel": {"core", "mesh", "geometry", "surfaces", "bending", "elasticity", "membrane", "integrate",
+                 "capsule", "flow"},
     "apps": {"core", "mesh", "geometry", "surfaces", "bending", "elasticity", "membrane", "integrate",
-             "capsule", "flow", "analysis"},
+             "capsule", "flow", "analysis", "parallel"},
 }
 
 INCLUDE = re.compile(r'^\s*#\s*include\s*"bendlab/([^/"]+)/[^"]*"', re.MULTILINE)

@@ -1,5 +1,15 @@
 // bendlab: membrane bending forces on triangulated surfaces, and capsules in flow.
+// Started by mpirun or srun (in a build with BENDLAB_MPI), every rank runs the same command: MPI
+// is initialised here, only rank 0 prints notes and progress, and an error on any rank prints
+// its message (naming the rank) and ends every rank with MPI_Abort (docs/mpi.md).
+#include <fmt/format.h>
+
+#include <cstdio>
+#include <cstdlib>
 #include <iostream>
+#ifdef BENDLAB_HAVE_MPI
+#include <mpi.h>
+#endif
 
 #include "bendlab/core/types.hpp"
 #include "command.hpp"
@@ -11,11 +21,68 @@ std::vector<CommandSetup>& command_registry() {
   return registry;
 }
 
-void note(const std::string& message) { std::cerr << message << std::endl; }
+namespace {
+ProcessWorld& world() {
+  static ProcessWorld w;
+  return w;
+}
+}  // namespace
+
+const ProcessWorld& process_world() { return world(); }
+
+void note(const std::string& message) {
+  if (world().rank == 0) std::cerr << message << std::endl;
+}
 
 }  // namespace bendlab::cli
 
+namespace {
+
+#ifdef BENDLAB_HAVE_MPI
+// Whether a process launcher started this process as one of a parallel job (Open MPI's mpirun,
+// PMI/PMIx launchers such as srun). A plain `bendlab ...` does not initialise MPI.
+bool launched_by_mpi() {
+  for (const char* v : {"OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_RANK", "PMI_SIZE"})
+    if (std::getenv(v) != nullptr) return true;
+  return false;
+}
+#endif
+
+struct MpiSession {
+  bool active = false;
+  MpiSession(int& argc, char**& argv) {
+#ifdef BENDLAB_HAVE_MPI
+    if (!launched_by_mpi()) return;
+    MPI_Init(&argc, &argv);
+    active = true;
+    auto& w = bendlab::cli::world();
+    MPI_Comm_rank(MPI_COMM_WORLD, &w.rank);
+    MPI_Comm_size(MPI_COMM_WORLD, &w.size);
+#else
+    (void)argc;
+    (void)argv;
+#endif
+  }
+  ~MpiSession() {
+#ifdef BENDLAB_HAVE_MPI
+    if (active) MPI_Finalize();
+#endif
+  }
+  // An error on one rank: the others may wait in a collective call, so every rank is ended.
+  [[noreturn]] void abort_all(int code) {
+#ifdef BENDLAB_HAVE_MPI
+    if (active) MPI_Abort(MPI_COMM_WORLD, code);
+#endif
+    std::exit(code);
+  }
+};
+
+}  // namespace
+
 int main(int argc, char** argv) {
+  MpiSession mpi(argc, argv);
+  const auto& world = bendlab::cli::process_world();
+  const std::string who = world.size > 1 ? fmt::format("bendlab (rank {} of {})", world.rank, world.size) : "bendlab";
   CLI::App app{"bendlab: membrane bending forces on triangulated surfaces, checked against exact "
                "analytic results, and elastic capsules in shear flow"};
   app.require_subcommand(1);
@@ -24,13 +91,18 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
-    // A usage error: one line naming the problem, as for every other error.
-    std::cerr << "bendlab: error: " << e.what() << " (see --help)" << std::endl;
+    if (e.get_exit_code() == 0) return world.rank == 0 ? app.exit(e) : 0;  // --help, --version
+    // A usage error: one line naming the problem, as for every other error. Every rank parses
+    // the same arguments, so every rank ends here alike.
+    if (world.rank == 0) std::cerr << "bendlab: error: " << e.what() << " (see --help)" << std::endl;
     return e.get_exit_code();
   } catch (const std::exception& e) {
     // Commands do their work in callbacks, which run inside parse().
-    std::cerr << "bendlab: error: " << e.what() << std::endl;
+    // One write per line, so that the ranks' lines do not interleave.
+    const std::string line = fmt::format("{}: error: {}\n", who, e.what());
+    std::fputs(line.c_str(), stderr);
+    std::fflush(stderr);
+    if (world.size > 1) mpi.abort_all(1);
     return 1;
   }
   return 0;

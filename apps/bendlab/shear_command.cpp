@@ -15,6 +15,9 @@
 #include "cli_common.hpp"
 #include "method_cli.hpp"
 #include "command.hpp"
+#ifdef BENDLAB_HAVE_MPI
+#include "bendlab/parallel/mpi_lbm_capsule_solver.hpp"
+#endif
 
 namespace fs = std::filesystem;
 
@@ -78,7 +81,22 @@ void shear(const ShearArgs& a) {
                      p.theta, p.elapsed_seconds, p.eta_seconds) +
          (p.mlups > 0 ? fmt::format("  {:.1f} MLUPS", p.mlups) : std::string()));
   };
+  const ProcessWorld& world = process_world();
+  if (world.size > 1) {
+#ifdef BENDLAB_HAVE_MPI
+    if (a.solver != "lbm")
+      throw Error(fmt::format("{} processes: only --solver lbm runs in parallel (start the boundary-integral solver "
+                              "without mpirun)", world.size));
+    // The fluid in y-slabs over the ranks; rank 0 writes the run folder (docs/mpi.md).
+    callbacks.make_lbm_solver = [](std::shared_ptr<const MembraneModel> m, const LbmSolverOptions& o) {
+      return std::make_unique<parallel::MpiLbmCapsuleSolver>(std::move(m), o, MPI_COMM_WORLD);
+    };
+    callbacks.writes_files = world.rank == 0;
+    note(fmt::format("lattice Boltzmann fluid in y-slabs over {} MPI ranks", world.size));
+#endif
+  }
   const CapsuleRunResult result = run_shear(spec, callbacks);
+  if (world.rank != 0) return;
   if (!result.finished) {
     note(fmt::format("stopped after {} steps; continue with --resume", a.stop_after_steps));
     return;

@@ -98,9 +98,9 @@ CapsuleRunResult run_capsule(CapsuleSolver& solver, const CapsuleRunOptions& o) 
                               solver.name()));
     solver.restore_state(saved.positions, saved.time, saved.counters, saved.solver_state.fields, folder,
                          checkpoint_path.string());
-    series.emplace(TimeSeriesFile::resume(series_path, saved.steps));
+    if (o.writes_files) series.emplace(TimeSeriesFile::resume(series_path, saved.steps));
     const SteadyWindow window = SteadyWindow::for_run(o.t_end);
-    if (!(saved.steady.window() == window)) {
+    if (o.writes_files && !(saved.steady.window() == window)) {
       note(fmt::format("t_end moved the steady window from [{}, {}] to [{}, {}]: its sums are recomputed from {}",
                        saved.steady.window().begin, saved.steady.window().end, window.begin, window.end,
                        series_path.string()));
@@ -120,11 +120,15 @@ CapsuleRunResult run_capsule(CapsuleSolver& solver, const CapsuleRunOptions& o) 
   auto write_checkpoint = [&](const Points& x, double t) {
     const std::string tag = fmt::format("{:05d}", state.snapshots.size());
     const std::string name = fmt::format("snapshot_{}.vtp", tag);
-    write_mesh(folder / name, membrane.topology(), x);
+    if (o.writes_files) write_mesh(folder / name, membrane.topology(), x);
     state.snapshots.emplace_back(t, name);
-    write_pvd(folder / "shapes.pvd", state.snapshots);
+    if (o.writes_files) write_pvd(folder / "shapes.pvd", state.snapshots);
     const std::vector<std::string> old_side_files = state.solver_state.side_files;
     state.solver_state = solver.save_state(folder, tag);
+    if (!o.writes_files) {
+      state.time = t;
+      return;
+    }
     state.time = t;
     state.positions = x;
     state.counters = solver.counters();
@@ -139,8 +143,10 @@ CapsuleRunResult run_capsule(CapsuleSolver& solver, const CapsuleRunOptions& o) 
   };
 
   if (!o.resume) {
-    fs::create_directories(folder);
-    series.emplace(TimeSeriesFile::create(series_path));
+    if (o.writes_files) {
+      fs::create_directories(folder);
+      series.emplace(TimeSeriesFile::create(series_path));
+    }
     write_checkpoint(solver.positions(), solver.time());
   }
 
@@ -160,7 +166,7 @@ CapsuleRunResult run_capsule(CapsuleSolver& solver, const CapsuleRunOptions& o) 
       ++steps_here;
       last_good_time = s.time;
       const TimeSeriesRow row = capsule_sample(membrane, *s.positions, s.time, s.dt);
-      series->append(row);
+      if (series) series->append(row);
       state.steady.add(row);
       const bool at_end = s.time >= o.t_end - 1e-12;
       if (s.time >= next_snapshot - 1e-9 * o.snapshot_every || at_end) {
@@ -201,6 +207,10 @@ CapsuleRunResult run_capsule(CapsuleSolver& solver, const CapsuleRunOptions& o) 
   }
   CapsuleRunResult result;
   if (stopped) return result;
+  if (!o.writes_files) {
+    result.finished = true;
+    return result;
+  }
 
   const SolverCounters counters = solver.counters();
   nlohmann::json summary = o.arguments;

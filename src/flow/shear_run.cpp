@@ -124,9 +124,13 @@ CapsuleRunResult run_shear(const ShearRunSpec& a, const ShearRunCallbacks& callb
     lo.lattice = p;
     lo.kernel = in.kernel;
     lo.sample_every = l.sample_every;
-    auto lbm_solver = std::make_unique<LbmCapsuleSolver>(membrane, lo);
-    const auto sample_steps = lbm_solver->sample_steps();
-    solver = std::move(lbm_solver);
+    // LbmCapsuleSolver's reporting interval (a parallel solver takes the same steps).
+    const auto sample_steps = std::max<std::int64_t>(1, std::llround(l.sample_every / p.shear_rate));
+    if (callbacks.make_lbm_solver) {
+      solver = callbacks.make_lbm_solver(membrane, lo);
+    } else {
+      solver = std::make_unique<LbmCapsuleSolver>(membrane, lo);
+    }
     lattice_nodes = static_cast<double>(p.nx) * p.ny * p.nz;
     lattice_gamma = p.shear_rate;
     lattice_arguments = {{"radius_lu", l.radius_lu}, {"box", l.box},      {"tau", l.tau},
@@ -180,6 +184,7 @@ CapsuleRunResult run_shear(const ShearRunSpec& a, const ShearRunCallbacks& callb
     };
   o.should_stop = callbacks.should_stop;
   o.progress_interval_seconds = callbacks.progress_interval_seconds;
+  o.writes_files = callbacks.writes_files;
   return run_capsule(*solver, o);
 }
 

@@ -56,6 +56,11 @@ struct CapsuleRunOptions {
   /// resumable from the last checkpoint). How an interactive caller (Ctrl-C in Python) stops.
   std::function<bool()> should_stop;
   double progress_interval_seconds = 2;  ///< wall time between progress reports
+  /// false on every process of a parallel run but the first (MPI rank 0): the process steps,
+  /// checkpoints (solver.save_state is collective) and resumes with the others, but writes no
+  /// file of its own (no folder, time series, snapshot, checkpoint.json or summary.json), and
+  /// the result's summary is left empty.
+  bool writes_files = true;
   std::function<void(const CapsuleProgress&)> on_progress;
   std::function<void(const std::string&)> on_note;
 };

@@ -14,6 +14,7 @@
 
 #include "bendlab/bending/bending_method.hpp"
 #include "bendlab/capsule/capsule_run.hpp"
+#include "bendlab/flow/lbm/lbm_capsule_solver.hpp"
 
 namespace bendlab {
 
@@ -50,6 +51,12 @@ struct ShearRunCallbacks {
   std::function<void(const std::string&)> on_note;
   std::function<bool()> should_stop;  ///< true stops the run (resumable from its last checkpoint)
   double progress_interval_seconds = 2;
+  /// Builds the --solver lbm solver in place of LbmCapsuleSolver (a parallel run's: the command
+  /// line's MPI solver, parallel/mpi_lbm_capsule_solver.hpp). Same options, same checkpoints.
+  std::function<std::unique_ptr<CapsuleSolver>(std::shared_ptr<const MembraneModel>, const LbmSolverOptions&)>
+      make_lbm_solver;
+  /// false on the processes of a parallel run other than the first (CapsuleRunOptions::writes_files).
+  bool writes_files = true;
 };
 
 /// Checks every parameter (before any file is touched), builds the mesh, the membrane model and

@@ -25,11 +25,11 @@ struct Header {
 };
 #pragma pack(pop)
 
+static_assert(sizeof(Header) == kCheckpointHeaderBytes);
+
 }  // namespace
 
-void write_checkpoint(const Lattice& lattice, const std::filesystem::path& path) {
-  const auto& c = lattice.config();
-  const auto& f = lattice.raw_populations();
+std::string checkpoint_header(const LatticeConfig& c, std::int64_t step) {
   Header h{};
   std::memcpy(h.magic, kMagic, sizeof kMagic);
   h.version = kVersion;
@@ -40,15 +40,12 @@ void write_checkpoint(const Lattice& lattice, const std::filesystem::path& path)
   h.walls = c.walls ? 1 : 0;
   h.tau = c.tau;
   h.wall_velocity = c.wall_velocity;
-  h.step = lattice.step_count();
-  h.count = f.size();
-  AtomicFile out(path, true);
-  out.stream().write(reinterpret_cast<const char*>(&h), sizeof h);
-  out.stream().write(reinterpret_cast<const char*>(f.data()), static_cast<std::streamsize>(f.size() * sizeof(double)));
-  out.commit();
+  h.step = step;
+  h.count = static_cast<std::uint64_t>(kQ) * c.nx * c.ny * c.nz;
+  return std::string(reinterpret_cast<const char*>(&h), sizeof h);
 }
 
-void read_checkpoint(Lattice& lattice, const std::filesystem::path& path) {
+std::int64_t check_checkpoint_header(const LatticeConfig& c, const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(fmt::format("cannot open LBM checkpoint {}", path.string()));
   const std::string name = path.string();
@@ -59,7 +56,6 @@ void read_checkpoint(Lattice& lattice, const std::filesystem::path& path) {
   in.read(reinterpret_cast<char*>(&h), sizeof h);
   if (!in || std::memcmp(h.magic, kMagic, sizeof kMagic) != 0) throw Error(fmt::format("{} is not an LBM checkpoint (bad magic)", name));
   if (h.version != kVersion) throw Error(fmt::format("LBM checkpoint {} has version {}, this build reads {}", name, h.version, kVersion));
-  const auto& c = lattice.config();
   if (h.q != static_cast<std::uint32_t>(kQ) || h.nx != c.nx || h.ny != c.ny || h.nz != c.nz) {
     throw Error(fmt::format("LBM checkpoint {} is for a D3Q{} {} x {} x {} lattice, not D3Q{} {} x {} x {}", name, h.q, h.nx, h.ny, h.nz, kQ, c.nx, c.ny, c.nz));
   }
@@ -67,13 +63,32 @@ void read_checkpoint(Lattice& lattice, const std::filesystem::path& path) {
     throw Error(fmt::format("LBM checkpoint {} (walls {}, tau {}, wall velocity {}) does not match the lattice (walls {}, tau {}, wall velocity {})",
                             name, h.walls != 0, h.tau, h.wall_velocity, c.walls, c.tau, c.wall_velocity));
   }
-  if (h.count != lattice.raw_populations().size() || size != sizeof(Header) + h.count * sizeof(double)) {
-    throw Error(fmt::format("LBM checkpoint {} has {} bytes, expected {}", name, size, sizeof(Header) + lattice.raw_populations().size() * sizeof(double)));
+  const std::uint64_t count = static_cast<std::uint64_t>(kQ) * c.nx * c.ny * c.nz;
+  if (h.count != count || size != sizeof(Header) + count * sizeof(double)) {
+    throw Error(fmt::format("LBM checkpoint {} has {} bytes, expected {}", name, size, sizeof(Header) + count * sizeof(double)));
   }
-  std::vector<double> f(h.count);
+  if (h.step < 0) throw Error(fmt::format("LBM checkpoint {} has a negative step count {}", name, h.step));
+  return h.step;
+}
+
+void write_checkpoint(const Lattice& lattice, const std::filesystem::path& path) {
+  const auto& f = lattice.raw_populations();
+  const std::string header = checkpoint_header(lattice.config(), lattice.step_count());
+  AtomicFile out(path, true);
+  out.stream().write(header.data(), static_cast<std::streamsize>(header.size()));
+  out.stream().write(reinterpret_cast<const char*>(f.data()), static_cast<std::streamsize>(f.size() * sizeof(double)));
+  out.commit();
+}
+
+void read_checkpoint(Lattice& lattice, const std::filesystem::path& path) {
+  const std::int64_t step = check_checkpoint_header(lattice.config(), path);
+  const std::string name = path.string();
+  std::ifstream in(path, std::ios::binary);
+  in.seekg(static_cast<std::streamoff>(kCheckpointHeaderBytes));
+  std::vector<double> f(lattice.raw_populations().size());
   in.read(reinterpret_cast<char*>(f.data()), static_cast<std::streamsize>(f.size() * sizeof(double)));
   if (!in) throw Error(fmt::format("LBM checkpoint {} could not be read to the end", name));
-  lattice.restore_raw(std::move(f), h.step);
+  lattice.restore_raw(std::move(f), step);
 }
 
 }  // namespace bendlab::lbm

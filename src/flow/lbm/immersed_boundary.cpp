@@ -39,11 +39,9 @@ namespace {
 int wrap(int i, int n) { return ((i % n) + n) % n; }
 }  // namespace
 
-IbStencil ib_stencil(const Lattice& lattice, const Vec3& X, IbKernel kernel) {
+IbStencil ib_stencil(const std::array<int, 3>& n, bool walls, const Vec3& X, IbKernel kernel) {
   if (!X.allFinite()) throw Error("IB node position is not finite");
   const int m = static_cast<int>(std::ceil(ib_kernel_half_width(kernel)));
-  const int n[3] = {lattice.nx(), lattice.ny(), lattice.nz()};
-  const bool walls = lattice.config().walls;
   int idx[3][4];
   double w[3][4];
   int count = 2 * m;
@@ -68,13 +66,19 @@ IbStencil ib_stencil(const Lattice& lattice, const Vec3& X, IbKernel kernel) {
     for (int b = 0; b < count; ++b) {
       const double wbc = w[1][b] * w[2][c];
       for (int a = 0; a < count; ++a) {
-        st.node[st.size] = lattice.index(idx[0][a], idx[1][b], idx[2][c]);
+        st.node[st.size] = static_cast<std::size_t>(idx[0][a]) +
+                           static_cast<std::size_t>(n[0]) * (static_cast<std::size_t>(idx[1][b]) +
+                                                             static_cast<std::size_t>(n[1]) * static_cast<std::size_t>(idx[2][c]));
         st.weight[st.size] = w[0][a] * wbc;
         ++st.size;
       }
     }
   }
   return st;
+}
+
+IbStencil ib_stencil(const Lattice& lattice, const Vec3& X, IbKernel kernel) {
+  return ib_stencil({lattice.nx(), lattice.ny(), lattice.nz()}, lattice.config().walls, X, kernel);
 }
 
 void spread_forces(Lattice& lattice, const Points& X, const Points& F, IbKernel kernel) {

@@ -167,6 +167,7 @@ struct StepArgs {
   double* f;
   std::size_t n;
   int nx, ny, nz;
+  int j0, nj;  // the layers stepped: j0 <= j < j0 + nj (all of them: 0, ny)
   bool walls, odd;
   double v;
   const double* F[3];
@@ -264,8 +265,9 @@ bool odd_plan(const StepArgs& a, int j, int k, int xe, RowPlan& p) {
 template <class Coll>
 LBM_INLINE void process_rows_impl(const StepArgs& a, int row0, int row1, const Coll& coll) {
   RowPlan p;
-  for (int r = row0; r < row1; ++r) {
-    const int j = r % a.ny, k = r / a.ny;
+  for (int t = row0; t < row1; ++t) {
+    const int j = a.j0 + t % a.nj, k = t / a.nj;
+    const int r = j + a.ny * k;
     const std::ptrdiff_t row = static_cast<std::ptrdiff_t>(a.nx) * r;
     const double* Fx = a.F[0] + row;
     const double* Fy = a.F[1] + row;
@@ -388,10 +390,10 @@ void Lattice::set_uniform_force(const Vec3& F) {
 }
 
 template <class Coll>
-void Lattice::step_with(const Coll& coll) {
-  StepArgs a{f_.data(), n_, config_.nx, config_.ny, config_.nz, config_.walls, step_ % 2 == 1,
+void Lattice::step_with(const Coll& coll, int j0, int j1) {
+  StepArgs a{f_.data(), n_, config_.nx, config_.ny, config_.nz, j0, j1 - j0, config_.walls, step_ % 2 == 1,
              config_.wall_velocity, {force_[0].data(), force_[1].data(), force_[2].data()}};
-  const int rows = config_.ny * config_.nz;
+  const int rows = (j1 - j0) * config_.nz;
   // Small lattices (tests) step on one thread: a parallel region costs more than their update.
 #pragma omp parallel if (n_ >= kParallelNodes)
   {
@@ -403,12 +405,16 @@ void Lattice::step_with(const Coll& coll) {
   ++step_;
 }
 
-void Lattice::step() {
+void Lattice::step() { step_layers(0, config_.ny); }
+
+void Lattice::step_layers(int j0, int j1) {
+  if (j0 < 0 || j1 > config_.ny || j0 >= j1)
+    throw Error(fmt::format("LBM step of layers [{}, {}) outside the lattice's 0..{}", j0, j1, config_.ny));
   const double tau = config_.tau;
   if (collision_ == Collision::BGK) {
-    step_with(Bgk{1.0 / tau, 1.0 - 0.5 / tau});
+    step_with(Bgk{1.0 / tau, 1.0 - 0.5 / tau}, j0, j1);
   } else {
-    step_with(Regularized{1.0 - 1.0 / tau, 1.0 - 0.5 / tau});
+    step_with(Regularized{1.0 - 1.0 / tau, 1.0 - 0.5 / tau}, j0, j1);
   }
 }
 

@@ -41,6 +41,9 @@ struct IbStencil {
 };
 /// Throws bendlab::Error if X is not finite or its support crosses a wall.
 IbStencil ib_stencil(const Lattice& lattice, const Vec3& X, IbKernel kernel);
+/// The same for an n[0] x n[1] x n[2] lattice (with or without walls) that need not exist: node
+/// indices i + n0 (j + n1 k), as Lattice::index (a subdomain maps them to its own nodes).
+IbStencil ib_stencil(const std::array<int, 3>& n, bool walls, const Vec3& X, IbKernel kernel);
 
 /// Adds sum_k F_k Phi(x - X_k) to the lattice force field (X, F: N x 3).
 void spread_forces(Lattice& lattice, const Points& X, const Points& F, IbKernel kernel = IbKernel::Phi2);

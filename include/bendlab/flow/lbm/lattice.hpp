@@ -107,6 +107,11 @@ class Lattice {
   /// One step: collide with the force field (Guo), stream, bounce back at the walls. OpenMP over
   /// the (y, z) rows.
   void step();
+  /// One step of the layers j0 <= j < j1 only; the others keep their populations. For a
+  /// subdomain whose layers j0 - 1 and j1 are ghost copies of a neighbour's (kept by the caller,
+  /// parallel/distributed_lattice.hpp): a stepped layer then never wraps around in y.
+  /// step() is step_layers(0, ny()).
+  void step_layers(int j0, int j1);
   void run(std::int64_t steps) {
     for (std::int64_t s = 0; s < steps; ++s) step();
   }
@@ -123,12 +128,14 @@ class Lattice {
   /// The raw population store, kQ * num_nodes() doubles, slot-major, in the AA layout of
   /// step_count() (for checkpoints).
   const std::vector<double>& raw_populations() const { return f_; }
+  /// The same store, writable (for the halo exchange of a subdomain, parallel/distributed_lattice.hpp).
+  double* raw_data() { return f_.data(); }
   /// Replaces the raw store and the step count (sizes must match; for checkpoints).
   void restore_raw(std::vector<double> populations, std::int64_t step);
 
  private:
   template <class Coll>
-  void step_with(const Coll& coll);
+  void step_with(const Coll& coll, int j0, int j1);
 
   LatticeConfig config_;
   Collision collision_;

@@ -1,0 +1,57 @@
+#!/usr/bin/python3
+"""`mpirun -np N bendlab shear --solver lbm` against the serial command (ctest parallel.cli):
+the same files in the run folder, the same time series and summary (but the wall time) to the
+last digit, stdout's summary only once; a checkpoint of N ranks
+resumed by the serial command; an error on the ranks ends the run with status != 0 and a line
+naming the rank and the problem.
+Usage: cli_mpi_check.py BENDLAB MPIEXEC N
+"""
+import json
+import os
+import pathlib
+import subprocess
+import sys
+import tempfile
+
+bendlab, mpiexec, ranks = sys.argv[1], sys.argv[2], sys.argv[3]
+ARGS = ["shear", "--solver", "lbm", "--mesh", "mt1:320", "--radius-lu", "4", "--box", "2.5,2.5,3", "--G", "0.2",
+        "--t-end", "0.05", "--snapshot-every", "0.02", "--sample-every", "0.005", "--no-plot"]
+ENV = dict(os.environ, OMP_NUM_THREADS="1", OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+MPI = [mpiexec, "-n", ranks, "--oversubscribe"]
+
+
+def run(cmd, check=True):
+    r = subprocess.run(cmd, capture_output=True, text=True, env=ENV, timeout=240)
+    if check and r.returncode != 0:
+        sys.exit(f"FAILED ({r.returncode}): {' '.join(cmd)}\n{r.stdout}\n{r.stderr}")
+    return r
+
+
+def same_series(a, b, what):
+    ta, tb = (a / "timeseries.csv").read_text(), (b / "timeseries.csv").read_text()
+    assert ta.count("\n") > 5, f"{what}: {ta.count(chr(10))} lines"
+    assert ta == tb, f"{what}: the time series differ\n{ta}\n{tb}"
+
+
+with tempfile.TemporaryDirectory() as d:
+    d = pathlib.Path(d)
+    serial = run([bendlab] + ARGS + ["--out", str(d / "serial")])
+    par = run(MPI + [bendlab] + ARGS + ["--out", str(d / "par")])
+    assert sorted(os.listdir(d / "serial")) == sorted(os.listdir(d / "par")), (os.listdir(d / "serial"), os.listdir(d / "par"))
+    same_series(d / "serial", d / "par", "mpirun")
+    assert len(par.stdout.strip().splitlines()) == 1, f"summary printed {len(par.stdout.splitlines())} times"
+    a, b = json.loads(serial.stdout), json.loads(par.stdout)
+    a.pop("wall_seconds"), b.pop("wall_seconds")
+    assert a == b, (a, b)
+    # Interrupted on N ranks, resumed by the serial program.
+    run(MPI + [bendlab] + ARGS + ["--out", str(d / "resumed"), "--stop-after-steps", "5"])
+    run([bendlab] + ARGS + ["--out", str(d / "resumed"), "--resume"])
+    same_series(d / "serial", d / "resumed", "resume")
+    # A refused option on every rank: a non-zero status and one line per rank naming it.
+    (d / "file").write_text("")
+    bad = run(MPI + [bendlab] + ARGS + ["--out", str(d / "file")], check=False)
+    assert bad.returncode != 0, "an error must end the run with a non-zero status"
+    assert "error: --out" in bad.stderr and "is a file, not a folder" in bad.stderr, bad.stderr
+    if int(ranks) > 1:
+        assert "(rank 0 of " in bad.stderr, bad.stderr
+print(f"cli_mpi_check: mpirun -n {ranks} bendlab shear --solver lbm matches the serial command")
