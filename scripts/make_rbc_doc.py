@@ -225,6 +225,19 @@ def method_s_section(study, polar):
     return md
 
 
+# Why a method beyond the paper behaves as it does (data-independent; the numbers are in the tables).
+EXPLANATION = {
+    "J": "With the barycentric area (a third of the adjacent faces) J's H is exact only where the one-ring "
+         "is made of near-equilateral triangles. Around a vertex of valence v whose ring is v isosceles "
+         "triangles with apex angle 2 pi / v (the self-similar rings around the 12 valence-5 vertices of the "
+         "MT1 and MT2 families, and the valence-4 vertices of the octahedron family) H_i R tends to "
+         "3 / (4 cos^2(pi / v)) instead of 1 (1.146 for v = 5, 1.5 for v = 4; tests/bending/test_julicher.cpp), "
+         "whatever the resolution. So the maximal errors of H and K stay at a constant level while the "
+         "averages converge at about second order, and f = -dE/dx / A_mixed, which differentiates that "
+         "defect, grows at those vertices under refinement.",
+}
+
+
 def merge_study(study, extra):
     """Adds the methods of `extra` (a study of the same meshes) to `study`, in place."""
     if [(m["family"], m["triangles"]) for m in extra["meshes"]] != [(m["family"], m["triangles"]) for m in study["meshes"]]:
@@ -244,6 +257,8 @@ def extra_section(study, methods):
         md.append(f"## Method {m}: errors on every mesh family (not in the paper)\n")
         md.append(f"{NOT_IN_PAPER.get(m, 'not in the paper')}. Each cell: max / avg error of eq. (17); – : not "
                   "computed by the method.\n")
+        if m in EXPLANATION:
+            md.append(EXPLANATION[m] + "\n")
         quantities = [q for q in ("n", "H", "K", "lapH", "f")
                       if any(r["method"] == m and r["quantity"] == q for r in study["rows"])]
         fams = list(dict.fromkeys(r["family"] for r in study["rows"] if r["method"] == m))
@@ -284,10 +299,12 @@ def main():
     results = args[1] if len(args) > 1 else os.path.join(repo, "docs", "results")
     with open(os.path.join(study_dir, "errors.json")) as f:
         study = json.load(f)
-    extra_methods = []
+    extra_methods, extra = [], None
+    main_methods = list(study["options"]["methods"])  # the main study's command line
     if extra_dir:
         with open(os.path.join(extra_dir, "errors.json")) as f:
-            extra_methods = merge_study(study, json.load(f))
+            extra = json.load(f)
+        extra_methods = merge_study(study, extra)
     polar = None
     if polar_dir:
         with open(os.path.join(polar_dir, "errors.json")) as f:
@@ -312,11 +329,15 @@ def main():
     opts = study["options"]
     if command is None:
         command = (f"build/release/bendlab rbc --max-triangles {opts['max_triangles']} "
-                   f"--families {','.join(opts['families'])} --methods {','.join(opts['methods'])}"
+                   f"--families {','.join(opts['families'])} --methods {','.join(main_methods)}"
                    + (f" --rings {opts['rings']}" if opts.get("rings") else "")
                    + f" --out {study_dir} && /usr/bin/python3 scripts/make_rbc_doc.py {study_dir}"
                    + (f" --polar {polar_dir}" if polar_dir else "")
                    + (f" --extra {extra_dir}" if extra_dir else ""))
+        if extra_dir:
+            eo = extra["options"]
+            command = (f"build/release/bendlab rbc --max-triangles {eo['max_triangles']} --families "
+                       f"{','.join(eo['families'])} --methods {','.join(eo['methods'])} --out {extra_dir} && " + command)
         if polar_dir:
             command = polar["command"] + " && " + command
     md = []
