@@ -112,7 +112,9 @@ TEST(Skalak, IsotropicDilationGivesTheAreaModulus) {
       const double e = sk.energy(m.positions() * (1 + s));
       // At s = 1e-4 both sides lose digits to the cancellation in 2 I1 - 2 I2 = O(s^2).
       EXPECT_NEAR(e, W * A0, (s > 0.1 ? 1e-11 : 1e-6) * W * A0) << "C " << C << " s " << s;
-      if (s < 1e-3) EXPECT_NEAR(e, 2 * Gs * (1 + 2 * C) * s * s * A0, 5 * s * e) << "C " << C;
+      if (s < 1e-3) {
+        EXPECT_NEAR(e, 2 * Gs * (1 + 2 * C) * s * s * A0, 5 * s * e) << "C " << C;
+      }
     }
   }
 }
