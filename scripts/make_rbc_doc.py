@@ -9,6 +9,9 @@ docs/results of this repository) receives rbc.md and, in rbc/, the plots and the
 STUDY_DIR. --command is the command line quoted at the top of the document. --polar DIR adds
 the errors of Method S with the icosahedron's vertex at the poles (the --out folder of
 `bendlab rbc --base polar --families mt1 --methods S --no-plots`) beside the default orientation.
+--extra DIR merges the errors.json of another study of the same meshes and other methods (e.g.
+`bendlab rbc --methods J --out DIR`) into STUDY_DIR's tables, so a method added later is run alone;
+its plots (DIR/*.png) are copied with the prefix "extra_".
 
 Our tables 2 and 3 are set beside the paper's, transcribed below from
   A. Guckenberger, M. P. Schraml, P. G. Chen, M. Leonetti, S. Gekle, "On the bending algorithms
@@ -24,6 +27,10 @@ import sys
 PAPER_SOURCE = ("Guckenberger et al., *On the bending algorithms for soft objects in flows*, "
                 "Comput. Phys. Commun. 207 (2016), tables 2 and 3")
 PAPER_METHODS = ["A", "B", "C", "D", "E", "S"]
+# Methods beyond the paper: no paper symbol exists for them (Method J: Juelicher 1996, docs/design.md).
+NOT_IN_PAPER = {"ED": "the paper's proposed mixture (E for n, H, K and D's operator for Lap H), not in its tables",
+                "J": "Juelicher's edge-based mean curvature and its energy gradient (Juelicher 1996, compared by "
+                     "Bian et al. 2020); the paper has no Method J"}
 # None: the method does not compute the quantity (empty cell in the paper).
 PAPER_TABLE2 = {
     "max": {
@@ -218,6 +225,57 @@ def method_s_section(study, polar):
     return md
 
 
+# Why a method beyond the paper behaves as it does (data-independent; the numbers are in the tables).
+EXPLANATION = {
+    "J": "With the barycentric area (a third of the adjacent faces) J's H is exact only where the one-ring "
+         "is made of near-equilateral triangles. Around a vertex of valence v whose ring is v isosceles "
+         "triangles with apex angle 2 pi / v (the self-similar rings around the 12 valence-5 vertices of the "
+         "MT1 and MT2 families, and the valence-4 vertices of the octahedron family) H_i R tends to "
+         "3 / (4 cos^2(pi / v)) instead of 1 (1.146 for v = 5, tested in tests/bending/test_julicher.cpp; 1.5 for v = 4, "
+         "1.4997 measured on the 8192-triangle octahedron sphere), "
+         "whatever the resolution. So the maximal errors of H and K stay at a constant level while the "
+         "averages converge at about second order, and f = -dE/dx / A_mixed, which differentiates that "
+         "defect, grows at those vertices under refinement.",
+}
+
+
+def merge_study(study, extra):
+    """Adds the methods of `extra` (a study of the same meshes) to `study`, in place."""
+    if [(m["family"], m["triangles"]) for m in extra["meshes"]] != [(m["family"], m["triangles"]) for m in study["meshes"]]:
+        sys.exit("make_rbc_doc.py: --extra: the extra study's meshes differ from the main study's")
+    new = [m for m in extra["options"]["methods"] if m not in study["options"]["methods"]]
+    for key in ("rows", "rates", "inhomogeneous", "timings", "refused"):
+        study.setdefault(key, [])
+        study[key] += [r for r in extra.get(key, []) if r["method"] in new]
+    study["options"]["methods"] = study["options"]["methods"] + new
+    return new
+
+
+def extra_section(study, methods):
+    """Max / avg errors of methods beyond the paper on every mesh family, from the study's rows."""
+    md = []
+    for m in methods:
+        md.append(f"## Method {m}: errors on every mesh family (not in the paper)\n")
+        md.append(f"{NOT_IN_PAPER.get(m, 'not in the paper')}. Each cell: max / avg error of eq. (17); – : not "
+                  "computed by the method.\n")
+        if m in EXPLANATION:
+            md.append(EXPLANATION[m] + "\n")
+        quantities = [q for q in ("n", "H", "K", "lapH", "f")
+                      if any(r["method"] == m and r["quantity"] == q for r in study["rows"])]
+        fams = list(dict.fromkeys(r["family"] for r in study["rows"] if r["method"] == m))
+        table = []
+        for fam in fams:
+            rows = rows_of(study, fam, m)
+            for n in sorted(rows):
+                cells = [fam, str(n)]
+                for q in quantities:
+                    mx, avg = rows[n].get(q, (None, None))
+                    cells.append("–" if mx is None else f"{mx:.3g} / {avg:.3g}")
+                table.append(cells)
+        md.append(md_table(["family", "N_T"] + [f"ε_{QUANTITY_NAMES[q]}" for q in quantities], table))
+    return md
+
+
 def main():
     args = sys.argv[1:]
     command = None
@@ -225,6 +283,11 @@ def main():
     if "--polar" in args:
         i = args.index("--polar")
         polar_dir = args[i + 1]
+        del args[i:i + 2]
+    extra_dir = None
+    if "--extra" in args:
+        i = args.index("--extra")
+        extra_dir = args[i + 1]
         del args[i:i + 2]
     if "--command" in args:
         i = args.index("--command")
@@ -237,6 +300,12 @@ def main():
     results = args[1] if len(args) > 1 else os.path.join(repo, "docs", "results")
     with open(os.path.join(study_dir, "errors.json")) as f:
         study = json.load(f)
+    extra_methods, extra = [], None
+    main_methods = list(study["options"]["methods"])  # the main study's command line
+    if extra_dir:
+        with open(os.path.join(extra_dir, "errors.json")) as f:
+            extra = json.load(f)
+        extra_methods = merge_study(study, extra)
     polar = None
     if polar_dir:
         with open(os.path.join(polar_dir, "errors.json")) as f:
@@ -250,15 +319,26 @@ def main():
         shutil.copyfile(os.path.join(study_dir, name), os.path.join(asset_dir, name))
     if polar_dir:
         shutil.copyfile(os.path.join(polar_dir, "errors.json"), os.path.join(asset_dir, "errors_polar.json"))
+    extra_pngs = []
+    if extra_dir:
+        shutil.copyfile(os.path.join(extra_dir, "errors.json"), os.path.join(asset_dir, "errors_extra.json"))
+        for name in sorted(n for n in os.listdir(extra_dir) if n.endswith(".png")):
+            shutil.copyfile(os.path.join(extra_dir, name), os.path.join(asset_dir, "extra_" + name))
+            extra_pngs.append("extra_" + name)
 
     th = study["thresholds"]
     opts = study["options"]
     if command is None:
         command = (f"build/release/bendlab rbc --max-triangles {opts['max_triangles']} "
-                   f"--families {','.join(opts['families'])} --methods {','.join(opts['methods'])}"
+                   f"--families {','.join(opts['families'])} --methods {','.join(main_methods)}"
                    + (f" --rings {opts['rings']}" if opts.get("rings") else "")
                    + f" --out {study_dir} && /usr/bin/python3 scripts/make_rbc_doc.py {study_dir}"
-                   + (f" --polar {polar_dir}" if polar_dir else ""))
+                   + (f" --polar {polar_dir}" if polar_dir else "")
+                   + (f" --extra {extra_dir}" if extra_dir else ""))
+        if extra_dir:
+            eo = extra["options"]
+            command = (f"build/release/bendlab rbc --max-triangles {eo['max_triangles']} --families "
+                       f"{','.join(eo['families'])} --methods {','.join(eo['methods'])} --out {extra_dir} && " + command)
         if polar_dir:
             command = polar["command"] + " && " + command
     md = []
@@ -286,7 +366,8 @@ def main():
               f"○ converges to a systematic error: otherwise. Errors below {th['exact_error']:g} count as ●.\n")
     md.append(f"Each cell: **ours / paper**. Paper: {PAPER_SOURCE}, which uses MT2 meshes for Methods A-E "
               "and MT1 for S, so the comparison uses our MT2 meshes for A-E and our MT1 meshes for S; ED (the "
-              "paper's proposed mixture: E for n, H, K and D's operator for Lap H) and the normal n are not in the paper's table. – : not computed.\n")
+              "paper's proposed mixture: E for n, H, K and D's operator for Lap H), J (Juelicher's method, beyond "
+              "the paper) and the normal n are not in the paper's table: their paper cells read n/a. – : not computed.\n")
     for measure, title in (("max", "maximal errors"), ("avg", "average errors")):
         table, diffs = table2_section(study, "mt2", measure)
         md.append(f"### Table 2 ({title}), MT2\n\n" + table)
@@ -303,8 +384,18 @@ def main():
         head, _, body = part.partition("\n")
         if head.startswith("mt1"):
             md.append(f"#### {head}\n" + body.strip() + "\n")
+    if extra_dir:
+        with open(os.path.join(extra_dir, "table2.md")) as f:
+            t2 = f.read()
+        for part in t2.split("\n## ")[1:]:
+            head, _, body = part.partition("\n")
+            if head.startswith("mt1"):
+                md.append(f"#### {head} (Method(s) {', '.join(extra_methods)})\n" + body.strip() + "\n")
 
     md.append("## Table 3: the inhomogeneous mesh\n")
+    beyond = [m for m in study["options"]["methods"] if m in NOT_IN_PAPER]
+    if beyond:
+        md.append(f"Methods {', '.join(beyond)} are not in the paper's table 3 (its cells read –).\n")
     md.append(f"Each cell: **ours (r_max / r_avg) / paper**, r = error of the inhomogeneous mesh divided by the "
               f"error of its homogeneous family at the same h (log-log interpolation between the homogeneous "
               f"meshes around it). ● no troubles: both r < {th['inhomogeneous_factor']}; ○ only the maximal error "
@@ -324,6 +415,7 @@ def main():
                 md.append("\nEvery cell the paper fills agrees.\n")
 
     md += method_s_section(study, polar)
+    md += extra_section(study, [m for m in study["options"]["methods"] if m in NOT_IN_PAPER and m != "ED"])
 
     md.append("## Plots\n")
     md.append("Errors against 1/h with guide slopes h^1, h^2, h^-1, h^-2 (figures 3, 5, 7, 10 and, for MT2, "
@@ -338,6 +430,11 @@ def main():
                 md.append(f"![{QUANTITY_NAMES[q]} errors, {fam.upper()}](rbc/{name})\n")
     for name in pngs:
         if name.startswith("values_"):
+            md.append(f"![{name[:-4]}](rbc/{name})\n")
+    if extra_pngs:
+        md.append(f"The plots above are of the main study; those of Method(s) {', '.join(extra_methods)}, "
+                  "run as a separate study of the same meshes (`--extra`), follow.\n")
+        for name in extra_pngs:
             md.append(f"![{name[:-4]}](rbc/{name})\n")
 
     md.append("## Timings\n")

@@ -33,7 +33,7 @@ QUANTITIES = {
 }
 VALUE_COLUMNS = {"H": ("H", "H_exact", "$H$"), "lapH": ("lapH", "lapH_exact", "$\\Delta_S H$"),
                  "f": ("f_abs", "f_abs_exact", "$|\\mathbf{f}|$")}
-MARKERS = {"A": "o", "B": "s", "C": "^", "D": "v", "E": "D", "ED": "P", "S": "X"}
+MARKERS = {"A": "o", "B": "s", "C": "^", "D": "v", "E": "D", "ED": "P", "S": "X", "J": "h"}
 
 
 def read_rows(path):

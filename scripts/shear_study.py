@@ -95,7 +95,7 @@ METHOD_STYLE = {
     "none": dict(color="0.55", ls="--", lw=1.2),
     "A": dict(color="tab:blue"), "B": dict(color="tab:orange"), "C": dict(color="tab:green"),
     "D": dict(color="tab:red"), "E": dict(color="tab:purple"), "ED": dict(color="tab:brown", ls="-."),
-    "S": dict(color="black", ls=":"),
+    "S": dict(color="black", ls=":"), "J": dict(color="tab:olive", ls="--"),
 }
 
 _print_lock = threading.Lock()
@@ -549,7 +549,7 @@ def section_c(results, runs, t_end):
     window = steady_label(t_end)
     lines.append(f"Mean of the accepted Cash-Karp steps gamma dt whose end lies in gamma t in {window} "
                  "(`mean_gamma_dt` of summary.json), relative tolerance 1e-7, absolute tolerance 1e-6 R, "
-                 "as in the paper. Paper: table 4 (BIM, MT1). The paper has no column for ED; "
+                 "as in the paper. Paper: table 4 (BIM, MT1). The paper has no column for ED or J (Jülicher, beyond the paper); "
                  "'no bending' is its kB_hat = 0 column.")
     if t_end < 10:
         lines.append(f"Preview run: the window is gamma t in {window}, not [5, 10]; the steps early in a "

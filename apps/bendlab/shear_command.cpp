@@ -1,4 +1,4 @@
-// bendlab shear: an initially spherical capsule (neo-Hookean membrane + bending) in linear shear
+// bendlab shear: an initially spherical capsule (neo-Hookean or Skalak membrane + bending) in linear shear
 // flow, by the boundary integral method (paper section 4, --solver bim) or the immersed-boundary
 // lattice Boltzmann method (section 4.3.2, --solver lbm). Argument parsing only: the run is
 // run_shear (bendlab/flow/shear_run.hpp), whose folder (timeseries.csv, snapshots,
@@ -25,7 +25,9 @@ namespace bendlab::cli {
 namespace {
 
 struct ShearArgs {
-  std::string solver = "bim", method = "none", mesh = "mt1:1280", out, plot_script, integrator = "cash-karp";
+  std::string solver = "bim", method = "none", mesh = "mt1:1280", out, plot_script, integrator = "cash-karp",
+              membrane = "neo-hookean";
+  double skalak_c = 1;
   double G = 0.1, t_end = 10, snapshot_every = 0.5, rtol = 1e-7, atol = 1e-6;
   std::optional<double> kappa_b_hat, kappa_b;
   int rings = 0;
@@ -58,6 +60,8 @@ void shear(const ShearArgs& a) {
   ShearRunSpec spec;
   spec.lattice = a.lattice;
   spec.integrator = a.integrator;
+  spec.membrane = a.membrane;
+  spec.skalak_c = a.skalak_c;
   spec.folder = a.out;
   spec.solver = a.solver;
   spec.method = a.method;
@@ -107,8 +111,8 @@ void shear(const ShearArgs& a) {
 
 const CommandRegistration registration([](CLI::App& app) {
   auto args = std::make_shared<ShearArgs>();
-  auto* cmd = app.add_subcommand("shear", "Simulate an initially spherical capsule (neo-Hookean membrane plus "
-                                          "bending) in linear shear flow u = gamma z e_x at zero Reynolds number");
+  auto* cmd = app.add_subcommand("shear", "Simulate an initially spherical capsule (neo-Hookean or Skalak "
+                                          "membrane plus bending) in linear shear flow u = gamma z e_x at zero Reynolds number");
   cmd->add_option("--solver", args->solver,
                   "flow solver: bim (boundary integral method) or lbm (immersed-boundary lattice Boltzmann)")
       ->check(CLI::IsMember({"bim", "lbm"}))->capture_default_str();
@@ -118,6 +122,13 @@ const CommandRegistration registration([](CLI::App& app) {
   cmd->add_option("--mesh", args->mesh, "mt1:N or mt2:N (N triangles: 320, 1280, 5120, ...), inh:mt1 or inh:mt2 "
                                         "(320 triangles + 3 Rivara passes), or a mesh file (.off, .obj, .ply)")
       ->capture_default_str();
+  auto* membrane = cmd->add_option("--membrane", args->membrane,
+                                   "in-plane elastic law: neo-hookean (the paper's, eq. 18) or skalak "
+                                   "(Gs/4 (I1^2 + 2 I1 - 2 I2) + C Gs/4 I2^2 with Gs = kS/3)")
+      ->check(CLI::IsMember({"neo-hookean", "skalak"}))->capture_default_str();
+  cmd->add_option("--skalak-c", args->skalak_c,
+                  "the Skalak law's C > -1/2 (area modulus Gs (1 + 2C), Poisson ratio C/(1 + C); --membrane skalak)")
+      ->capture_default_str()->needs(membrane);
   cmd->add_option("--G", args->G, "dimensionless shear rate mu gamma R / kS (units R = mu = gamma = 1, kS = 1/G)")
       ->capture_default_str();
   auto* hat = cmd->add_option("--kappa-b-hat", args->kappa_b_hat,

@@ -44,6 +44,21 @@ def test_an_rkc_run_resumes_from_the_cli_and_equals_the_python_run(tmp_path, cli
         bendlab.shear_run(tmp_path / "bad", **dict(COMMON, integrator="euler"))
 
 
+def test_a_skalak_run_from_python_resumes_from_the_cli_and_refuses_another_law(tmp_path, cli):
+    sk = dict(COMMON, integrator="rkc", membrane="skalak", skalak_c=2.0)
+    full = bendlab.shear_run(tmp_path / "full", **sk)
+    assert full["membrane_law"] == "skalak" and full["skalak_c"] == 2.0
+    assert bendlab.shear_run(tmp_path / "parts", stop_after_steps=3, **sk) is None
+    with pytest.raises(Exception, match="membrane law skalak"):
+        bendlab.shear_run(tmp_path / "parts", resume=True, **dict(sk, membrane="neo-hookean", skalak_c=1.0))
+    cli("shear", "--integrator", "rkc", "--membrane", "skalak", "--skalak-c", "2", "--method", "C", "--mesh", "mt1:320",
+        "--G", "0.1", "--kappa-b-hat", "0.05", "--t-end", "0.3", "--snapshot-every", "0.1", "--no-plot", "--resume",
+        "--out", tmp_path / "parts")
+    assert without_wall(bendlab.read_summary(tmp_path / "parts")) == without_wall(full)
+    with pytest.raises(Exception, match="skalak-c"):
+        bendlab.shear_run(tmp_path / "bad", **dict(sk, skalak_c=-0.5))
+
+
 def test_progress_reaches_the_callback_and_ctrl_c_stops_cleanly(tmp_path):
     seen = []
 

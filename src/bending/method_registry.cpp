@@ -15,6 +15,7 @@
 #include "bendlab/bending/belkin.hpp"
 #include "bendlab/bending/farutin.hpp"
 #include "bendlab/bending/gompper_kroll.hpp"
+#include "bendlab/bending/julicher.hpp"
 #include "bendlab/bending/kantor_nelson.hpp"
 #include "bendlab/bending/loop_shell.hpp"
 #include "bendlab/bending/meyer.hpp"
@@ -25,12 +26,12 @@ namespace bendlab {
 namespace {
 
 /// The built-in methods, in the order of the paper's table 1 (then the conclusion's ED, then
-/// section 2.5's S).
+/// section 2.5's S, then J, which is not in the paper).
 /// A new built-in method adds its line here.
 std::vector<MethodInfo> builtin_methods() {
   return {KantorNelson::info(), GompperKroll::info(), MeyerMethod::info(),
           BelkinMethod::info(), FarutinMethod::info(), MixedEDMethod::info(),
-          LoopShellMethod::info()};
+          LoopShellMethod::info(), JulicherMethod::info()};
 }
 
 bool valid_name(const std::string& name) {

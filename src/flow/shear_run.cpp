@@ -3,10 +3,13 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
 
 #include "bendlab/bending/method_registry.hpp"
 #include "bendlab/capsule/run_tolerances.hpp"
 #include "bendlab/capsule/shear_units.hpp"
+#include "bendlab/elasticity/elastic_law.hpp"
 #include "bendlab/flow/bim/bim_capsule_solver.hpp"
 #include "bendlab/flow/lbm/lbm_capsule_solver.hpp"
 #include "bendlab/membrane/espresso_volume_force.hpp"
@@ -31,6 +34,28 @@ std::string method_list() {
   return s;
 }
 
+/// A resumed run must use the law (and Skalak's C) it was started with. run_capsule compares every
+/// argument too; this names the law in words before anything else is compared.
+void check_resumed_membrane(const ShearRunSpec& a) {
+  const fs::path path = a.folder / "checkpoint.json";
+  std::ifstream in(path);
+  const nlohmann::json saved = nlohmann::json::parse(in, nullptr, false);
+  if (saved.is_discarded() || !saved.is_object() || !saved.contains("arguments") || !saved["arguments"].is_object())
+    return;  // run_capsule refuses an unreadable checkpoint with its own message
+  const nlohmann::json& args = saved["arguments"];
+  const std::string law = args.contains("membrane") && args["membrane"].is_string()
+                              ? args["membrane"].get<std::string>() : "neo-hookean";
+  const auto describe = [](const std::string& name, double c) {
+    return name == "skalak" ? fmt::format("skalak with C = {}", c) : name;
+  };
+  const double c = args.contains("skalak_c") && args["skalak_c"].is_number() ? args["skalak_c"].get<double>()
+                                                                               : kDefaultSkalakC;
+  if (law != a.membrane || (law == "skalak" && c != a.skalak_c))
+    throw Error(fmt::format("--resume: the run in '{}' was started with the membrane law {}, not {}; a run "
+                            "cannot change its law",
+                            a.folder.string(), describe(law, c), describe(a.membrane, a.skalak_c)));
+}
+
 }  // namespace
 
 CapsuleRunResult run_shear(const ShearRunSpec& a, const ShearRunCallbacks& callbacks) {
@@ -53,6 +78,13 @@ CapsuleRunResult run_shear(const ShearRunSpec& a, const ShearRunCallbacks& callb
   const std::string tolerance_warning = check_run_tolerances(a.rtol, a.atol);
   if (a.integrator != "cash-karp" && a.integrator != "rkc")
     throw Error(fmt::format("--integrator '{}': the integrators are: cash-karp, rkc", a.integrator));
+  if (a.membrane != "neo-hookean" && a.membrane != "skalak")
+    throw Error(fmt::format("--membrane '{}': the membrane laws are: neo-hookean, skalak", a.membrane));
+  if (a.membrane == "skalak" && (!std::isfinite(a.skalak_c) || !(a.skalak_c > -0.5)))
+    throw Error(fmt::format("--skalak-c must be a finite number > -1/2 (area modulus Gs (1 + 2C) > 0), got {}",
+                            a.skalak_c));
+  if (a.membrane != "skalak" && a.skalak_c != kDefaultSkalakC)
+    throw Error("--skalak-c is for --membrane skalak");
   if (a.stop_after_steps < 0) throw Error("--stop-after-steps must be >= 0");
   const ShearUnits units = ShearUnits::from(a.G, a.kappa_b_hat, a.kappa_b);
   if (a.method == "none" && units.kappa_b_hat > 0)
@@ -65,6 +97,7 @@ CapsuleRunResult run_shear(const ShearRunSpec& a, const ShearRunCallbacks& callb
     throw Error(fmt::format("--out '{}' is a file, not a folder", a.folder.string()));
   if (a.resume && !fs::exists(a.folder / "checkpoint.json"))
     throw Error(fmt::format("--resume: no checkpoint in '{}' to resume from", a.folder.string()));
+  if (a.resume) check_resumed_membrane(a);
   const TriMesh mesh = mesh_from_spec(a.mesh);
   if (bending) {
     // One evaluation on the initial shape, so that a mesh the method refuses (Method S: two
@@ -78,6 +111,8 @@ CapsuleRunResult run_shear(const ShearRunSpec& a, const ShearRunCallbacks& callb
   mp.kS = units.kS();
   mp.kB = units.kB();
   mp.bending = bending;
+  mp.elastic_law = a.membrane;
+  mp.skalak_c = a.skalak_c;
   std::unique_ptr<CapsuleSolver> solver;
   nlohmann::json lattice_arguments = nlohmann::json::object();
   nlohmann::json summary_fields = {{"rtol", a.rtol}, {"atol", a.atol}};
@@ -171,7 +206,15 @@ CapsuleRunResult run_shear(const ShearRunSpec& a, const ShearRunCallbacks& callb
   // Cash-Karp runs keep the identity they had before the integrator could be chosen, so their
   // checkpoints still resume; another integrator is part of the identity.
   if (a.integrator != "cash-karp") o.arguments["integrator"] = a.integrator;
+  // Likewise neo-Hookean runs keep their identity; the Skalak law and its C are part of it, so a
+  // run is never resumed under another law.
+  if (a.membrane != "neo-hookean") {
+    o.arguments["membrane"] = a.membrane;
+    o.arguments["skalak_c"] = a.skalak_c;
+  }
   for (const auto& [key, value] : lattice_arguments.items()) o.arguments[key] = value;
+  summary_fields["membrane_law"] = a.membrane;
+  if (a.membrane == "skalak") summary_fields["skalak_c"] = a.skalak_c;
   o.summary_fields = summary_fields;
   o.on_note = callbacks.on_note;
   if (callbacks.on_progress)

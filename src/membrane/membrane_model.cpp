@@ -24,7 +24,7 @@ MembraneModel::MembraneModel(const TriMesh& reference, MembraneParameters parame
     : topology_(reference.topology_ptr()),
       reference_(reference.positions()),
       parameters_(checked(parameters)),
-      elastic_(make_elastic_law(parameters_.elastic_law, topology_, reference_, parameters_.kS)),
+      elastic_(make_elastic_law(parameters_.elastic_law, topology_, reference_, parameters_.kS, parameters_.skalak_c)),
       reference_volume_(enclosed_volume(*topology_, reference_)) {}
 
 void MembraneModel::forces(const Points& x, Points& force) const {

@@ -163,7 +163,7 @@ TEST_F(Cli, MethodsListsTheRegistryAsTableAndJson) {
                             "needs_admissible_mesh", "cost"})
       EXPECT_TRUE(m["capabilities"].contains(key)) << key;
   }
-  EXPECT_EQ(names, (std::vector<std::string>{"A", "B", "C", "D", "E", "ED", "S"}));
+  EXPECT_EQ(names, (std::vector<std::string>{"A", "B", "C", "D", "E", "ED", "S", "J"}));
   EXPECT_TRUE(j[6]["capabilities"]["needs_admissible_mesh"].get<bool>());
   EXPECT_TRUE(j[0]["capabilities"]["has_energy"].get<bool>());
   EXPECT_FALSE(j[2]["capabilities"]["has_energy"].get<bool>());
@@ -498,4 +498,41 @@ TEST_F(Cli, ShearResumeToAnEarlierOrEqualEndIsRefused) {
     EXPECT_EQ(slurp(out / "summary.json"), summary);
     EXPECT_EQ(slurp(out / "timeseries.csv"), series);
   }
+}
+
+TEST_F(Cli, ShearSkalakLawIsRecordedAndPartOfTheRunsIdentity) {
+  const std::string common = " --mesh mt1:320 --G 0.1 --t-end 0.2 --snapshot-every 0.1 --integrator rkc --no-plot --out ";
+  const fs::path out = dir / "skalak", full = dir / "skalak_full";
+  CliRun r = run("shear --membrane skalak --skalak-c 2 --stop-after-steps 5" + common + out.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  // Resuming under the neo-Hookean law, or with another C, is refused naming the law.
+  expect_refused(run("shear --resume" + common + out.string()), "membrane law skalak with C = 2", dir / "nothing");
+  expect_refused(run("shear --resume --membrane skalak --skalak-c 3" + common + out.string()), "C = 2",
+                 dir / "nothing");
+  r = run("shear --resume --membrane skalak --skalak-c 2" + common + out.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  r = run("shear --membrane skalak --skalak-c 2" + common + full.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  auto a = nlohmann::json::parse(slurp(out / "summary.json"));
+  auto b = nlohmann::json::parse(slurp(full / "summary.json"));
+  EXPECT_EQ(a["membrane_law"], "skalak");
+  EXPECT_EQ(a["skalak_c"].get<double>(), 2.0);
+  a.erase("wall_seconds");
+  b.erase("wall_seconds");
+  EXPECT_EQ(a, b);
+  // A neo-Hookean run names its law and cannot be resumed as a Skalak one.
+  const fs::path nh = dir / "nh";
+  r = run("shear --stop-after-steps 3" + common + nh.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  expect_refused(run("shear --resume --membrane skalak" + common + nh.string()), "membrane law neo-hookean",
+                 dir / "nothing");
+  r = run("shear --resume" + common + nh.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(slurp(nh / "summary.json"))["membrane_law"], "neo-hookean");
+  // Inadmissible or misplaced C, unknown law: refused before any file is written.
+  expect_refused(run("shear --membrane skalak --skalak-c -0.5" + common + (dir / "bad").string()), "--skalak-c",
+                 dir / "bad");
+  expect_refused(run("shear --membrane neo-hookean --skalak-c 2" + common + (dir / "bad").string()), "--skalak-c",
+                 dir / "bad");
+  expect_refused(run("shear --membrane mooney" + common + (dir / "bad").string()), "--membrane", dir / "bad");
 }

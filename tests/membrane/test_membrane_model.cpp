@@ -127,8 +127,14 @@ TEST(MembraneModel, RefusesBadParameters) {
   p.kB = 1;  // no bending method
   EXPECT_THROW(MembraneModel(m, p), Error);
   p.kB = 0;
-  p.elastic_law = "skalak";  // not yet
+  p.elastic_law = "mooney-rivlin";  // unknown
   EXPECT_THROW(MembraneModel(m, p), Error);
+  p.elastic_law = "skalak";
+  p.skalak_c = -0.5;  // area modulus 0: not admissible
+  EXPECT_THROW(MembraneModel(m, p), Error);
+  p.skalak_c = 2;
+  EXPECT_EQ(MembraneModel(m, p).elastic_law().name(), "Skalak");
+  p.elastic_law = "neo-hookean";
   const MembraneModel ok(m, MembraneParameters{});
   Points f;
   EXPECT_THROW(ok.forces(Points::Zero(3, 3), f), Error);

@@ -33,7 +33,7 @@ using MethodOptions = std::map<std::string, std::string>;
 class BendingMethod {
  public:
   virtual ~BendingMethod() = default;
-  /// Short name: "A", "B", "C", "D", "E", "ED", "S".
+  /// Short name: "A", "B", "C", "D", "E", "ED", "S", "J".
   virtual std::string name() const = 0;
   /// Every per-vertex quantity of the method.
   virtual BendingResult compute(const Topology& topology, const Points& x, double kappa_b) const = 0;

@@ -1,8 +1,8 @@
 #pragma once
 // The in-plane elastic law of a capsule membrane (paper section 4.2): an energy E_S(x) of the node
 // positions relative to a reference state fixed at construction, and its exact nodal forces
-// F = -dE_S/dx. The neo-Hookean law (eqs. (18)-(21), bendlab/elasticity/neo_hookean.hpp) is one
-// implementation; a Skalak law adds another file and one name in make_elastic_law().
+// F = -dE_S/dx. The neo-Hookean law (eqs. (18)-(21), bendlab/elasticity/neo_hookean.hpp) and the
+// Skalak law (bendlab/elasticity/skalak.hpp) implement it; make_elastic_law() names them.
 //
 // Implementations are immutable after construction and their const methods are safe to call
 // concurrently (scratch is allocated per call).
@@ -31,12 +31,16 @@ class ElasticLaw {
   virtual double energy_and_forces(const Points& x, Points& force) const = 0;
 };
 
-/// The names make_elastic_law() accepts: {"neo-hookean"}.
+/// The names make_elastic_law() accepts: {"neo-hookean", "skalak"}.
 std::vector<std::string> elastic_law_names();
 
-/// The law `name` with reference state (topology, reference positions) and modulus kS. Throws
-/// bendlab::Error for an unknown name, kS <= 0 or a degenerate reference triangle.
+/// Skalak's C when none is given (area modulus 3 Gs, as the neo-Hookean law's at small strain).
+inline constexpr double kDefaultSkalakC = 1.0;
+
+/// The law `name` with reference state (topology, reference positions) and modulus kS;
+/// `skalak_c` is the Skalak law's C (ignored by the neo-Hookean law). Throws bendlab::Error for an
+/// unknown name, kS <= 0, C <= -1/2 (Skalak) or a degenerate reference triangle.
 std::unique_ptr<ElasticLaw> make_elastic_law(const std::string& name, TopologyPtr topology, const Points& reference,
-                                             double kS);
+                                             double kS, double skalak_c = kDefaultSkalakC);
 
 }  // namespace bendlab

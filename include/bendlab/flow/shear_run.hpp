@@ -1,5 +1,6 @@
 #pragma once
-// The paper's section 4 run, as one library call: an initially spherical capsule (elastic law +
+// The paper's section 4 run, as one library call: an initially spherical capsule (elastic law
+// (neo-Hookean, or Skalak beyond the paper) +
 // bending method) in the shear flow u = gamma z e_x, in the units of capsule/shear_units.hpp
 // (R = mu = gamma = 1, kS = 1/G, kB = kappa_b_hat / G), solved by a flow solver behind
 // CapsuleSolver and kept by run_capsule (capsule/capsule_run.hpp: time series, snapshots,
@@ -34,6 +35,8 @@ struct ShearRunSpec {
   LatticeRunSpec lattice;              ///< used by "lbm"
   std::string method = "none";         ///< bending method (registry name) or "none"
   MethodOptions method_options;        ///< options of the method, as on a command line
+  std::string membrane = "neo-hookean";  ///< in-plane elastic law: "neo-hookean" or "skalak" (elasticity/)
+  double skalak_c = 1;                 ///< the Skalak law's C (> -1/2); only with membrane = "skalak"
   std::string mesh = "mt1:1280";       ///< mesh_spec.hpp: mt1:N, mt2:N, octa:N, inh:mt1, inh:mt2 or a file
   double G = 0.1;                      ///< mu gamma R / kS
   std::optional<double> kappa_b_hat;   ///< kB / (R^2 kS) (exclusive with kappa_b)

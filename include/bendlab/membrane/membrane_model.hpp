@@ -1,6 +1,6 @@
 #pragma once
 // The membrane of a capsule as ONE force model (paper sections 2 and 4.2): in-plane elasticity
-// (an ElasticLaw, neo-Hookean by default, eqs. (18)-(21)) + bending (any BendingMethod, eq. (10)
+// (an ElasticLaw: neo-Hookean by default, eqs. (18)-(21), or Skalak) + bending (any BendingMethod, eq. (10)
 // or an energy gradient) + an optional volume force, all relative to one reference state
 // (reference positions + shared Topology).
 //
@@ -28,7 +28,8 @@ namespace bendlab {
 struct MembraneParameters {
   double kS = 1;                  ///< in-plane modulus of the elastic law (> 0)
   double kB = 0;                  ///< bending modulus (>= 0; > 0 needs `bending`)
-  std::string elastic_law = "neo-hookean";  ///< a name of make_elastic_law()
+  std::string elastic_law = "neo-hookean";  ///< a name of make_elastic_law(): neo-hookean, skalak
+  double skalak_c = kDefaultSkalakC;        ///< the Skalak law's C (> -1/2; elasticity/skalak.hpp)
   std::shared_ptr<const BendingMethod> bending;  ///< nullptr: no bending forces
   std::shared_ptr<const VolumeForce> volume_force;  ///< nullptr: none
 };
