@@ -53,6 +53,8 @@ CapsuleRunResult run_shear(const ShearRunSpec& a, const ShearRunCallbacks& callb
   const std::string tolerance_warning = check_run_tolerances(a.rtol, a.atol);
   if (a.integrator != "cash-karp" && a.integrator != "rkc")
     throw Error(fmt::format("--integrator '{}': the integrators are: cash-karp, rkc", a.integrator));
+  const SingleLayerQuadrature quadrature = single_layer_quadrature(a.bim_quadrature);
+  if (a.solver != "bim" && a.bim_quadrature != "all7") throw Error("--bim-quadrature is for --solver bim");
   if (a.stop_after_steps < 0) throw Error("--stop-after-steps must be >= 0");
   const ShearUnits units = ShearUnits::from(a.G, a.kappa_b_hat, a.kappa_b);
   if (a.method == "none" && units.kappa_b_hat > 0)
@@ -99,6 +101,8 @@ CapsuleRunResult run_shear(const ShearRunSpec& a, const ShearRunCallbacks& callb
     BimOptions bim;
     bim.mu = ShearUnits::mu;
     bim.gamma = ShearUnits::gamma;
+    bim.quadrature.quadrature = quadrature;
+    summary_fields["bim_quadrature"] = a.bim_quadrature;
     solver = std::make_unique<BimCapsuleSolver>(membrane, std::move(integrator), bim);
   } else {
     const LatticeRunSpec& l = a.lattice;
@@ -167,6 +171,8 @@ CapsuleRunResult run_shear(const ShearRunSpec& a, const ShearRunCallbacks& callb
   // Cash-Karp runs keep the identity they had before the integrator could be chosen, so their
   // checkpoints still resume; another integrator is part of the identity.
   if (a.integrator != "cash-karp") o.arguments["integrator"] = a.integrator;
+  // Likewise the quadrature: runs of the reference (all7) keep the identity they always had.
+  if (a.bim_quadrature != "all7") o.arguments["bim_quadrature"] = a.bim_quadrature;
   for (const auto& [key, value] : lattice_arguments.items()) o.arguments[key] = value;
   o.summary_fields = summary_fields;
   o.on_note = callbacks.on_note;
