@@ -201,7 +201,8 @@ void StokesSingleLayer::prepare(const Points& x, const Points& f) const {
       const Vec3 c = (row(x, F(tf, 0)) + row(x, F(tf, 1)) + row(x, F(tf, 2))) / 3.0;
       std::uint64_t key = 0;
       for (int d = 0; d < 3; ++d) {
-        const double q = std::clamp((c[d] - lo[d]) * scale, 0.0, static_cast<double>((1 << 21) - 1));
+        double q = (c[d] - lo[d]) * scale;
+        q = q >= 0 ? std::min(q, static_cast<double>((1 << 21) - 1)) : 0.0;  // also NaN -> 0
         key |= spread_bits(static_cast<std::uint64_t>(q)) << d;
       }
       keys_[tf] = key;
