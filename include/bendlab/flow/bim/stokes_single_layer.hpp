@@ -26,7 +26,8 @@
 //   Measured (bench/bench_bim.cpp BM_QuadratureRatio, tests/flow/test_stokes_single_layer.cpp),
 //   as the difference max_i |u_adaptive(x_i) - u_all7(x_i)| / max_i |u_all7(x_i)|, with Method C's
 //   bending force density, one thread: on the 5120-triangle red blood cell and 2:1:0.5 ellipsoid
-//   the defaults (32, 1, 4) give 4e-5 to 1e-4 at 1.3 to 1.5 times the speed of all7; a bound of 1e-5
+//   the defaults (32, 1, 4) give 4e-5 to 1.2e-4 at 1.1 to 1.5 times the speed of all7 (wall clock,
+//   shared machine; at 1280 triangles they are slower than all7, 0.85 times); a bound of 1e-5
 //   needs (cluster_size, far_order, far_ratio) = (64, 4, 6) (2e-6 and 7e-6) or (32, 1, 10), where
 //   the gain is 1.2 times at most: with a cluster's far zone beginning 6 to 10 radii away, most of
 //   a 5120-triangle capsule is near every cluster, and the 7-point rule dominates. The adaptive rule
