@@ -5,8 +5,13 @@
 // 81920 triangles).
 //
 //   belkin_neighbours TRIANGLES [CUTOFF ...] [skip-all]   (CUTOFF default 1e-15; skip-all: no reference)
+//   belkin_neighbours scaling [TRIANGLES ...]             (default 5120 20480 81920)
+// The second form times Method C and Method D (grid, default cutoff) per size, each the best of
+// three evaluations, and prints D's time per vertex (constant for O(N)) and the ratio D / C. Run it
+// with OMP_NUM_THREADS=1 for the one-thread ratio.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <ctime>
 #include <string>
 #include <vector>
@@ -29,7 +34,31 @@ double seconds(F&& f) {
 double rel(const Points& a, const Points& ref) { return (a - ref).cwiseAbs().maxCoeff() / ref.cwiseAbs().maxCoeff(); }
 }  // namespace
 
+int scaling(const std::vector<long>& sizes) {
+  const auto c = make_bending_method("C");
+  const auto d = make_bending_method("D");
+  for (long triangles : sizes) {
+    const TriMesh m = sphere_mesh(MeshFamily::MT1, level_with_triangles(MeshFamily::MT1, triangles));
+    const Points x = make_rbc()->map_from_unit_sphere(m.positions());
+    double tc = 1e300, td = 1e300;
+    for (int rep = 0; rep < 3; ++rep) {
+      BendingResult r;
+      tc = std::min(tc, seconds([&] { r = c->compute(m.topology(), x, 1.0); }));
+      td = std::min(td, seconds([&] { r = d->compute(m.topology(), x, 1.0); }));
+    }
+    fmt::print("triangles {:6d} vertices {:6d} | C {:.4f} s | D {:.4f} s, {:.3f} us per vertex | D / C {:.2f}\n",
+               m.num_faces(), m.num_vertices(), tc, td, 1e6 * td / m.num_vertices(), td / tc);
+  }
+  return 0;
+}
+
 int main(int argc, char** argv) {
+  if (argc >= 2 && std::string(argv[1]) == "scaling") {
+    std::vector<long> sizes;
+    for (int k = 2; k < argc; ++k) sizes.push_back(std::stol(argv[k]));
+    if (sizes.empty()) sizes = {5120, 20480, 81920};
+    return scaling(sizes);
+  }
   if (argc < 2) {
     fmt::print(stderr, "usage: {} TRIANGLES [CUTOFF ...] [skip-all]\n", argv[0]);
     return 2;

@@ -3,9 +3,19 @@
 //   ./build/release/bench_bim
 //
 // Benchmarks (arguments: triangles, OpenMP threads):
-//   BM_SingleLayer        StokesSingleLayer::velocity at every node, force density f = n z
-//                         (n the outward normal): quadrature set-up, the 7-point rule over every
-//                         triangle for every node, and the polar integrals at each node's triangles.
+//   BM_SingleLayer/<quadrature>
+//                         StokesSingleLayer::velocity at every node, force density f = n z
+//                         (n the outward normal): quadrature set-up, the regular rule (all7: the
+//                         7-point rule over every triangle for every node; adaptive: the 7-point
+//                         rule near, the moment-corrected centroid rule far), and the polar
+//                         integrals at each node's triangles.
+//   BM_QuadratureRatio/<shape> (arguments: triangles, threads) both quadratures on one shape in
+//                         every iteration, force density = Method C's bending force density
+//                         (kB = 1) on that shape: counters speedup = (time of all7) / (time of
+//                         adaptive), summed over the iterations of this one run, and rel_diff =
+//                         max_i |u_adaptive(x_i) - u_all7(x_i)| / max_i |u_all7(x_i)|. Shapes: the
+//                         red blood cell of eq. (15) (R = 1) and the ellipsoid of half axes
+//                         2, 1, 0.5, both mapped from the MT1 sphere.
 //   BM_StokesletReference/<isa>
 //                         the regular part alone, on contiguous arrays: for every node, the
 //                         Stokeslet sum over the 7 N_T quadrature points of the same mesh, with the
@@ -26,6 +36,7 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <map>
 #include <memory>
@@ -34,8 +45,10 @@
 #include <immintrin.h>
 #endif
 
+#include "bendlab/bending/bending_method.hpp"
 #include "bendlab/flow/bim/stokes_single_layer.hpp"
 #include "bendlab/mesh/generators.hpp"
+#include "bendlab/surfaces/analytic_surface.hpp"
 
 using namespace bendlab;
 
@@ -71,11 +84,13 @@ void set_pair_counters(benchmark::State& state, const TriMesh& mesh, int threads
       benchmark::Counter(1.0, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
 
-void BM_SingleLayer(benchmark::State& state) {
+void BM_SingleLayer(benchmark::State& state, SingleLayerQuadrature quadrature) {
   const TriMesh& mesh = unit_sphere(static_cast<int>(state.range(0)));
   const int threads = static_cast<int>(state.range(1));
   omp_set_num_threads(threads);
-  const StokesSingleLayer single_layer(mesh.topology_ptr());
+  SingleLayerOptions options;
+  options.quadrature = quadrature;
+  const StokesSingleLayer single_layer(mesh.topology_ptr(), options);
   const Points f = smooth_density(mesh.positions());
   Points u(mesh.num_vertices(), 3);
   for (auto _ : state) {
@@ -85,11 +100,64 @@ void BM_SingleLayer(benchmark::State& state) {
   }
   set_pair_counters(state, mesh, threads);
 }
-BENCHMARK(BM_SingleLayer)
-    ->ArgsProduct({{1280, 5120, 20480}, {1, 2}})
-    ->ArgNames({"triangles", "threads"})
-    ->UseRealTime()
-    ->Unit(benchmark::kMillisecond);
+#define BENDLAB_SINGLE_LAYER(name, q)                \
+  BENCHMARK_CAPTURE(BM_SingleLayer, name, q)          \
+      ->ArgsProduct({{1280, 5120, 20480}, {1, 2}})    \
+      ->ArgNames({"triangles", "threads"})            \
+      ->UseRealTime()                                 \
+      ->Unit(benchmark::kMillisecond)
+BENDLAB_SINGLE_LAYER(all7, SingleLayerQuadrature::all7);
+BENDLAB_SINGLE_LAYER(adaptive, SingleLayerQuadrature::adaptive);
+
+enum Shape { kRbc, kEllipsoid };
+
+void BM_QuadratureRatio(benchmark::State& state, Shape shape) {
+  const TriMesh& sphere = unit_sphere(static_cast<int>(state.range(0)));
+  const int threads = static_cast<int>(state.range(1));
+  omp_set_num_threads(threads);
+  Points x = sphere.positions();
+  if (shape == kRbc) {
+    x = make_rbc(1.0)->map_from_unit_sphere(x);
+  } else {
+    x.col(0) *= 2.0;
+    x.col(2) *= 0.5;
+  }
+  const BendingResult bending = make_bending_method("C")->compute(sphere.topology(), x, 1.0);
+  const Points& f = bending.force_density;
+  SingleLayerOptions reference_options, adaptive_options;
+  reference_options.quadrature = SingleLayerQuadrature::all7;
+  adaptive_options.quadrature = SingleLayerQuadrature::adaptive;
+  const StokesSingleLayer reference(sphere.topology_ptr(), reference_options);
+  const StokesSingleLayer adaptive(sphere.topology_ptr(), adaptive_options);
+  Points u_ref(x.rows(), 3), u(x.rows(), 3);
+  double t_ref = 0, t_adaptive = 0;
+  using Clock = std::chrono::steady_clock;
+  for (auto _ : state) {
+    const auto t0 = Clock::now();
+    reference.velocity(x, f, 1.0, u_ref);
+    const auto t1 = Clock::now();
+    adaptive.velocity(x, f, 1.0, u);
+    const auto t2 = Clock::now();
+    benchmark::DoNotOptimize(u.data());
+    benchmark::DoNotOptimize(u_ref.data());
+    t_ref += std::chrono::duration<double>(t1 - t0).count();
+    t_adaptive += std::chrono::duration<double>(t2 - t1).count();
+  }
+  state.counters["triangles"] = sphere.num_faces();
+  state.counters["threads"] = threads;
+  state.counters["s_all7"] = t_ref / static_cast<double>(state.iterations());
+  state.counters["s_adaptive"] = t_adaptive / static_cast<double>(state.iterations());
+  state.counters["speedup"] = t_ref / t_adaptive;
+  state.counters["rel_diff"] = (u - u_ref).rowwise().norm().maxCoeff() / u_ref.rowwise().norm().maxCoeff();
+}
+#define BENDLAB_RATIO(name, shape)                    \
+  BENCHMARK_CAPTURE(BM_QuadratureRatio, name, shape)  \
+      ->ArgsProduct({{1280, 5120, 20480}, {1, 2}})    \
+      ->ArgNames({"triangles", "threads"})            \
+      ->UseRealTime()                                 \
+      ->Unit(benchmark::kMillisecond)
+BENDLAB_RATIO(rbc, kRbc);
+BENDLAB_RATIO(ellipsoid, kEllipsoid);
 
 // Quadrature points and weighted densities of the 7-point rule on every triangle, structure of
 // arrays, as the solver lays them out.

@@ -219,7 +219,8 @@ def main():
     per_core_target("Method B (`forces`, what a flow solver calls)", "BM_Forces", "B", CB_TARGET_VPS)
     per_core_target("Method B (`compute`, every quantity)", "BM_Compute", "B", CB_TARGET_VPS)
     per_core_target("Method E (`compute`, 1 ring)", "BM_Compute", "E", E_TARGET_VPS)
-    r = find(bim, "BM_SingleLayer", triangles=5120, threads=2)
+    # The solver's default quadrature (all7); reports from before the choice have no variant.
+    r = find(bim, "BM_SingleLayer", "all7", triangles=5120, threads=2) or find(bim, "BM_SingleLayer", triangles=5120, threads=2)
     s = counter(r, "s_per_eval")
     if s is None:
         w(f"| single layer, 5120 triangles, 2 threads, at most {BIM_TARGET_S} s per evaluation | not measured | - | **not met** | - |")
@@ -267,7 +268,10 @@ def main():
         w("")
         w("MT1 meshes mapped onto the red blood cell of section 3; `compute` returns every per-vertex")
         w("quantity, `forces` only the node forces (A and B implement it separately; for the other")
-        w("methods it calls `compute`). Methods D and ED sum over every vertex pair (O(N^2)) and run a")
+        w("methods it calls `compute`). Methods D and ED are O(N): Belkin's heat kernel truncated where its")
+        w("weight falls below `kernel_cutoff` (1e-15), the neighbours found through a cell list once per")
+        w("shape (`bending/belkin.hpp`); their O(N^2) all-pairs reference and D's cost per vertex and ratio")
+        w("to C are measured by `bench/belkin_neighbours`. A method of registry cost O(N^2) would run a")
         w("single iteration at 81920 triangles. `E_rings2`, `E_rings3`: Method E fitted on 2 and 3 rings.")
         w("")
         w("| method | call | triangles | threads | time (ms) | CPU time of the main thread (ms) | vertices/s | vertices/s per thread | iterations |")
@@ -287,8 +291,12 @@ def main():
     if bim:
         w("## Boundary integral (`bench_bim`)")
         w("")
-        w("One `StokesSingleLayer::velocity` on an MT1 unit sphere with the force density f = n z;")
-        w("pairs = N_vertices x N_triangles x 7 (the 7-point rule over every triangle for every node).")
+        w("One `StokesSingleLayer::velocity` on an MT1 unit sphere with the force density f = n z, with")
+        w("each regular quadrature: `all7` (the default and reference: the 7-point rule over every triangle")
+        w("for every node) and `adaptive` (the 7-point rule near a node, the moment-corrected centroid rule")
+        w("on clusters of 32 triangles far from it; `flow/bim/stokes_single_layer.hpp`).")
+        w("pairs = N_vertices x N_triangles x 7 for both (the pairs of the reference: for `adaptive` an")
+        w("equivalent rate).")
         w("`BM_StokesletReference` is the regular part alone on contiguous arrays of the same points, with")
         w("the same arithmetic and nothing else, for three instruction sets: `baseline` (what the build")
         w("targets by default), `avx2` (4 doubles a vector, FMA) and `avx512` (8 doubles); the fastest is")
@@ -312,7 +320,7 @@ def main():
 
         skipped = set()
         for r in bim["rows"]:
-            if r["family"] == "BM_MultiplyAddPeak":
+            if r["family"] in ("BM_MultiplyAddPeak", "BM_QuadratureRatio"):
                 continue
             b, a_ = r["b"], r["args"]
             label = r["family"] + (f" ({r['variant']})" if r["variant"] else "")
@@ -331,6 +339,20 @@ def main():
             w(f"| {label} | {a_.get('triangles')} | {a_.get('threads')} | {seconds(b):.4g} | "
               f"{si(b.get('pairs_per_s'))} | {si(b.get('pairs_per_s_per_thread'))} | {eff} | {eff2} |")
         w("")
+        ratios = [r for r in bim["rows"] if r["family"] == "BM_QuadratureRatio" and not r["error"]]
+        if ratios:
+            w("`BM_QuadratureRatio`: both quadratures in every iteration of one run, on the red blood cell")
+            w("(R = 1) and the 2:1:0.5 ellipsoid, force density = Method C's bending force density;")
+            w("speedup = time of all7 / time of adaptive; difference = max_i |u_adaptive - u_all7| /")
+            w("max_i |u_all7| (the adaptive defaults; `stokes_single_layer.hpp` lists settings within 1e-5).")
+            w("")
+            w("| shape | triangles | threads | s all7 | s adaptive | speedup | difference |")
+            w("| --- | --- | --- | --- | --- | --- | --- |")
+            for r in ratios:
+                b, a_ = r["b"], r["args"]
+                w(f"| {r['variant']} | {a_.get('triangles')} | {a_.get('threads')} | {b.get('s_all7', 0):.4g} | "
+                  f"{b.get('s_adaptive', 0):.4g} | {b.get('speedup', 0):.2f} | {b.get('rel_diff', 0):.2e} |")
+            w("")
         peaks = [r for r in bim["rows"] if r["family"] == "BM_MultiplyAddPeak"]
         for r in peaks:
             if r["error"]:

@@ -26,7 +26,7 @@ namespace {
 
 struct ShearArgs {
   std::string solver = "bim", method = "none", mesh = "mt1:1280", out, plot_script, integrator = "cash-karp",
-              membrane = "neo-hookean";
+              membrane = "neo-hookean", bim_quadrature = "all7";
   double skalak_c = 1;
   double G = 0.1, t_end = 10, snapshot_every = 0.5, rtol = 1e-7, atol = 1e-6;
   std::optional<double> kappa_b_hat, kappa_b;
@@ -54,7 +54,8 @@ void plot(const ShearArgs& a) {
 
 void shear(const ShearArgs& a) {
   if (a.solver == "lbm" && a.given_tolerance)
-    throw Error("--integrator, --rtol and --atol are for --solver bim: the lattice Boltzmann solver takes fixed steps");
+    throw Error("--integrator, --rtol, --atol and --bim-quadrature are for --solver bim: the lattice Boltzmann "
+                "solver takes fixed steps");
   if (a.solver == "bim" && a.given_lattice)
     throw Error("--radius-lu, --box, --tau, --reynolds, --kernel and --sample-every are for --solver lbm");
   ShearRunSpec spec;
@@ -62,6 +63,7 @@ void shear(const ShearArgs& a) {
   spec.integrator = a.integrator;
   spec.membrane = a.membrane;
   spec.skalak_c = a.skalak_c;
+  spec.bim_quadrature = a.bim_quadrature;
   spec.folder = a.out;
   spec.solver = a.solver;
   spec.method = a.method;
@@ -141,6 +143,11 @@ const CommandRegistration registration([](CLI::App& app) {
   cmd->add_option("--integrator", args->integrator,
                   "time integrator of the BIM: cash-karp (the paper's) or rkc (Runge-Kutta-Chebyshev, stiff-stable)")
       ->check(CLI::IsMember({"cash-karp", "rkc"}))->capture_default_str()->each(tolerance);
+  cmd->add_option("--bim-quadrature", args->bim_quadrature,
+                  "regular quadrature of the BIM's single layer: all7 (the 7-point rule everywhere, the reference) "
+                  "or adaptive (7-point rule near each node, moment-corrected centroid rule far: 1.1 to 1.5 times "
+                  "faster at 5120 triangles, velocities within about 1e-4 of all7)")
+      ->check(CLI::IsMember({"all7", "adaptive"}))->capture_default_str()->each(tolerance);
   auto lattice = [args](const std::string&) { args->given_lattice = true; };
   cmd->add_option("--rtol", args->rtol, "relative tolerance of the adaptive integrator (bim); above 1e-2 refused, "
                   "above 1e-4 warned (less accurate D, theta)")->capture_default_str()->each(tolerance);

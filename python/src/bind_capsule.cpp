@@ -33,7 +33,7 @@ void bind_capsule(py::module_& m) {
          std::optional<double> kappa_b_hat, std::optional<double> kappa_b, double t_end, double snapshot_every,
          double rtol, double atol, bool resume, std::int64_t stop_after_steps, const py::object& progress,
          double progress_interval, const py::dict& method_options, const std::string& integrator,
-         const std::string& membrane, double skalak_c) -> py::object {
+         const std::string& membrane, double skalak_c, const std::string& bim_quadrature) -> py::object {
         ShearRunSpec spec;
         spec.folder = folder;
         spec.method = method;
@@ -47,6 +47,7 @@ void bind_capsule(py::module_& m) {
         spec.integrator = integrator;
         spec.membrane = membrane;
         spec.skalak_c = skalak_c;
+        spec.bim_quadrature = bim_quadrature;
         spec.rtol = rtol;
         spec.atol = atol;
         spec.resume = resume;
@@ -91,10 +92,12 @@ void bind_capsule(py::module_& m) {
       py::arg("stop_after_steps") = 0, py::arg("progress") = py::none(), py::arg("progress_interval") = 2.0,
       py::arg("method_options") = py::dict(), py::arg("integrator") = "cash-karp",
       py::arg("membrane") = "neo-hookean", py::arg("skalak_c") = 1.0,
+      py::arg("bim_quadrature") = "all7",
       "Runs an initially spherical capsule (membrane law `membrane`: 'neo-hookean', eqs. 18-21, or 'skalak' "
       "with C = skalak_c; plus the bending method) in "
       "the shear flow u = gamma z e_x with the boundary integral method (eqs. 22-23), units R = mu = gamma "
-      "= 1 (kS = 1/G, kB = kappa_b_hat / G), advanced by `integrator` ('cash-karp' or 'rkc'), until gamma t = t_end, keeping the run folder (timeseries.csv, "
+      "= 1 (kS = 1/G, kB = kappa_b_hat / G), advanced by `integrator` ('cash-karp' or 'rkc'), the single layer's regular quadrature "
+      "`bim_quadrature` (the reference 'all7' or 'adaptive'), until gamma t = t_end, keeping the run folder (timeseries.csv, "
       "snapshots, checkpoint.json, summary.json) exactly as `bendlab shear` does. progress(dict) is called "
       "every progress_interval seconds. Returns summary.json's content, or None when stopped by "
       "stop_after_steps. Ctrl-C (or an exception in progress) stops the run at the next step and is raised; "

@@ -85,6 +85,8 @@ CapsuleRunResult run_shear(const ShearRunSpec& a, const ShearRunCallbacks& callb
                             a.skalak_c));
   if (a.membrane != "skalak" && a.skalak_c != kDefaultSkalakC)
     throw Error("--skalak-c is for --membrane skalak");
+  const SingleLayerQuadrature quadrature = single_layer_quadrature(a.bim_quadrature);
+  if (a.solver != "bim" && a.bim_quadrature != "all7") throw Error("--bim-quadrature is for --solver bim");
   if (a.stop_after_steps < 0) throw Error("--stop-after-steps must be >= 0");
   const ShearUnits units = ShearUnits::from(a.G, a.kappa_b_hat, a.kappa_b);
   if (a.method == "none" && units.kappa_b_hat > 0)
@@ -134,6 +136,8 @@ CapsuleRunResult run_shear(const ShearRunSpec& a, const ShearRunCallbacks& callb
     BimOptions bim;
     bim.mu = ShearUnits::mu;
     bim.gamma = ShearUnits::gamma;
+    bim.quadrature.quadrature = quadrature;
+    summary_fields["bim_quadrature"] = a.bim_quadrature;
     solver = std::make_unique<BimCapsuleSolver>(membrane, std::move(integrator), bim);
   } else {
     const LatticeRunSpec& l = a.lattice;
@@ -212,6 +216,8 @@ CapsuleRunResult run_shear(const ShearRunSpec& a, const ShearRunCallbacks& callb
     o.arguments["membrane"] = a.membrane;
     o.arguments["skalak_c"] = a.skalak_c;
   }
+  // Likewise the quadrature: runs of the reference (all7) keep the identity they always had.
+  if (a.bim_quadrature != "all7") o.arguments["bim_quadrature"] = a.bim_quadrature;
   for (const auto& [key, value] : lattice_arguments.items()) o.arguments[key] = value;
   summary_fields["membrane_law"] = a.membrane;
   if (a.membrane == "skalak") summary_fields["skalak_c"] = a.skalak_c;

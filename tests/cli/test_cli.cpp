@@ -337,7 +337,7 @@ TEST_F(Cli, ShearLbmWritesTheFilesOfABimRun) {
   const auto a = nlohmann::json::parse(slurp(bim / "summary.json"));
   const auto b = nlohmann::json::parse(slurp(lbm / "summary.json"));
   for (const auto& [key, value] : a.items())
-    if (key != "rtol" && key != "atol" && key != "integrator") {  // the BIM's stepping
+    if (key != "rtol" && key != "atol" && key != "integrator" && key != "bim_quadrature") {  // the BIM's own
       EXPECT_TRUE(b.contains(key)) << key;
     }
   EXPECT_EQ(b["solver"], "lbm");
@@ -402,6 +402,24 @@ TEST_F(Cli, ShearRkcStoppedAndResumedEqualsUninterrupted) {
                  "integrator", parts / "nothing");
   expect_refused(run("shear --integrator euler --mesh mt1:320 --no-plot --out " + (dir / "e").string()), "integrator",
                  dir / "e");
+}
+
+TEST_F(Cli, ShearBimQuadratureIsRecordedAndPartOfTheIdentity) {
+  const fs::path out = dir / "adaptive";
+  const std::string common = " --mesh mt1:320 --G 0.1 --t-end 0.02 --snapshot-every 0.01 --no-plot --out ";
+  CliRun r = run("shear --bim-quadrature adaptive --stop-after-steps 1" + common + out.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  r = run("shear --bim-quadrature adaptive --resume" + common + out.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(slurp(out / "summary.json"))["bim_quadrature"], "adaptive");
+  // The reference is the default; resuming an adaptive run with it is refused.
+  expect_refused(run("shear --resume" + common + out.string()), "bim_quadrature", out / "nothing");
+  const fs::path ref = dir / "all7";
+  ASSERT_EQ(run("shear" + common + ref.string()).status, 0);
+  EXPECT_EQ(nlohmann::json::parse(slurp(ref / "summary.json"))["bim_quadrature"], "all7");
+  expect_refused(run("shear --bim-quadrature fast" + common + (dir / "f").string()), "bim-quadrature", dir / "f");
+  expect_refused(run("shear --solver lbm --bim-quadrature adaptive" + common + (dir / "l").string()),
+                 "--bim-quadrature", dir / "l");
 }
 
 TEST_F(Cli, ShearModuliAndMissingPlotScript) {

@@ -17,29 +17,37 @@
 // Two evaluations of the same sum (BelkinOptions::neighbours, method option "neighbours"):
 //
 // - all (the O(N^2) reference): every vertex sees every vertex, OpenMP over i. Terms whose exponent
-//   |p - x_i|^2 / (4 a_i) exceeds 80 are skipped without calling exp: together they change
-//   (Lap w)_i by at most e^-80 A_total 2 max|w| / (4 pi a_i^2) ~ 3e-36 N max|w| / a_i
-//   (A_total / a_i ~ N), far below the rounding error of the kept sum for any mesh that fits in
-//   memory.
+//   |p - x_i|^2 / (4 a_i) exceeds 80 are skipped: together they change (Lap w)_i by at most
+//   e^-80 A_total 2 max|w| / (4 pi a_i^2) ~ 3e-36 N max|w| / a_i (A_total / a_i ~ N), far below
+//   the rounding error of the kept sum for any mesh that fits in memory.
 // - grid (the default, O(N)): terms whose kernel weight exp(-|p - x_i|^2 / (4 a_i)) is below
 //   kernel_cutoff (method option "kernel_cutoff", default 1e-15) are dropped, so vertex i only
 //   sees the points within r_i = sqrt(4 a_i ln(1 / kernel_cutoff)), found through a uniform grid
 //   of cells (a cell list sorted by cell, cells of half the median r_i). With a_i ~ A_total / N the
 //   ball holds about 4 pi ln(1/cutoff) vertices (about 430 at the default) whatever N: O(N).
+//   The neighbour lists (for each vertex, the runs of cell-sorted points, one per row of cells
+//   meeting its ball) are built once per shape, when the operator is constructed, and serve every
+//   apply() (Method D applies it to x and to H).
 //   Truncation error: each of the at most N dropped terms has weight A_p * exp(-exponent) <=
 //   A_p * cutoff and |w(p) - w(x_i)| <= 2 max|w|, so (Lap w)_i changes by at most
 //       cutoff * (sum of the dropped A_p) * 2 max|w| / (4 pi a_i^2)
 //     <= cutoff * A_total * 2 max|w| / (4 pi a_i^2)  ~  cutoff * N * max|w| / (2 pi a_i)
 //   (A_total / a_i ~ N); for the 5120-triangle red blood cell (A_total = 8.76, a_i >= 1.3e-3)
 //   that is at most 1e-15 * 8.76 * 2 / (4 pi 1.8e-6) ~ 8e-10 max|w|, against max|Lap x| =
-//   2 max|H| = 4.4. In practice far less (the dropped
-//   weights decay like a Gaussian beyond r_i): measured max-norm differences from the reference,
-//   relative, for Method D's f on the red blood cell: 3e-14 (1280 triangles), 3e-13 (5120),
-//   1.3e-12 (20480), 7.5e-12 (81920); with cutoff 1e-12 they are 3e-11, 1.6e-10, 7e-10, 5.9e-9
-//   (bench/belkin_neighbours). One Method D evaluation at 81920 triangles, one thread: 0.57 s
-//   against 8.3 s for the reference (Method C: 0.05 s).
+//   2 max|H| = 4.4. In practice far less (the dropped weights decay like a Gaussian beyond r_i):
+//   measured max-norm differences from the reference, relative, for Method D's f on the red
+//   blood cell: 3e-14 (1280 triangles), 3e-13 (5120), 1.3e-12 (20480), 7.5e-12 (81920); with
+//   cutoff 1e-12 they are 3e-11, 1.6e-10, 7e-10, 5.9e-9 (bench/belkin_neighbours).
 //   Values below e^-80 are clamped to e^-80, the reference's own cut, so that both forms keep the
 //   same terms and differ only by the order of the sum.
+// Both forms run one kernel loop (belkin.cpp): over blocks of points of a run, branch-free, the
+// exponent, the half-space and cut-off tests as a 0/1 factor and the exponential by a polynomial
+// (within an ulp of exp, measured over [0, 80]), so that it vectorises (AVX-512, AVX2 or
+// baseline, chosen at run time). One Method D evaluation on the red blood cell, one thread, best
+// of several, processor time on the shared 2-core machine (bench/belkin_neighbours scaling):
+// 81920 triangles 0.105 to 0.14 s against Method C's 0.009 to 0.013 s (12 to 16 times C; the
+// all-pairs reference 4.6 s); 3.6 to 4.5 us per vertex from 5120 to 81920 triangles (linear).
+// The same build before the lists were kept and the loop vectorised: 0.55 to 0.60 s (62 times C).
 // Both are deterministic; they differ only by the order of the sum and the dropped terms.
 // The operator of a constant is exactly zero in both (every term carries w(p) - w(x_i) = 0).
 #include <memory>
@@ -87,8 +95,6 @@ class BelkinLaplacian {
  private:
   template <int Cols>
   void apply_columns(const double* const* w, double* const* out) const;
-  template <int Cols>
-  void apply_columns_grid(const double* const* w, double* const* out) const;
   void build_grid();
 
   BelkinOptions options_;
@@ -97,13 +103,16 @@ class BelkinLaplacian {
   std::vector<double> qnorm_;         ///< |x_p - c|
   Scalars lumped_area_;
   Scalars kernel_area_;               ///< a_i = A_mixed_i
-  // The grid form: cells of side cell_ from lo_, dims_[0] x dims_[1] x dims_[2], x fastest; the
-  // vertices sorted by cell (order_), with their data in that order (s*_), and the cell of each.
-  double max_exponent_ = 80;  ///< -ln(kernel_cutoff), at most 80
+  double max_exponent_ = 80;  ///< -ln(kernel_cutoff), at most 80 (the reference: 80)
+  // The grid form: cells of side cell_ from lo_, dims_[0] x dims_[1] x dims_[2], x fastest.
   double cell_ = 0;
   double lo_[3] = {0, 0, 0};
   int dims_[3] = {1, 1, 1};
-  std::vector<int> cell_start_, order_, cell_of_;
+  // The points in scan order (grid: sorted by cell; reference: vertex order): order_[k] is the
+  // vertex at position k, s*_ its data. Vertex i scans the runs [runs_[r], runs_[r + 1]) for r in
+  // [run_start_[i], run_start_[i + 1]) step 2 (run_shared_: every vertex the one run runs_[0..1]).
+  std::vector<int> order_, run_start_, runs_;
+  bool run_shared_ = false;
   std::vector<double> sx_, sy_, sz_, snorm_, slump_;
 };
 

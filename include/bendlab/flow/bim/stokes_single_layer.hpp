@@ -8,7 +8,32 @@
 //
 // evaluated at every node x_i (the imposed flow u_inf is not included). f is the membrane force
 // density given at the nodes and interpolated linearly over each triangle [43].
-// - Triangles that do not contain x_i: the 7-point Gauss rule of degree 5 (Strang-Fix / Dunavant [117]).
+// - Triangles that do not contain x_i: the 7-point Gauss rule of degree 5 (Strang-Fix / Dunavant [117])
+//   for every target (SingleLayerQuadrature::all7, the reference and the default), or (adaptive)
+//   that rule only near the target and a cheaper one far from it, chosen per (target, cluster):
+//     * the triangles are sorted by the Morton key of their centroids and cut into clusters of
+//       `cluster_size` consecutive triangles (spatially compact); cluster c has centre c_c (mean of
+//       its triangles' centroids) and radius rho_c (largest distance from c_c to a corner);
+//     * far rule of a cluster: one point per triangle, its centroid z_t, with vector weights W_t =
+//       W0_t + dW_t, W0_t = A_t mean(f) (the centroid rule, exact for the density's integral) and
+//       dW the least-norm correction that makes the cluster's moments
+//       sum_t m((z_t - c_c)/rho_c) W_t = sum_k m((y_k - c_c)/rho_c) w_k f_k
+//       equal to those of its 7-point rule for every monomial m of degree <= `far_order` (1: 4
+//       monomials; clusters with fewer triangles than monomials always use the 7-point rule);
+//     * a target x_i uses the far rule for cluster c when |x_i - c_c| >= far_ratio * rho_c. By the
+//       Taylor expansion of G about c_c, the far rule then differs from the 7-point rule by
+//       O((rho_c / |x_i - c_c|)^(far_order + 1)) relative to the cluster's (absolute) contribution.
+//   Measured (bench/bench_bim.cpp BM_QuadratureRatio, tests/flow/test_stokes_single_layer.cpp),
+//   as the difference max_i |u_adaptive(x_i) - u_all7(x_i)| / max_i |u_all7(x_i)|, with Method C's
+//   bending force density, one thread: on the 5120-triangle red blood cell and 2:1:0.5 ellipsoid
+//   the defaults (32, 1, 4) give 4e-5 to 1.2e-4 at 1.1 to 1.5 times the speed of all7 (wall clock,
+//   shared machine; at 1280 triangles they are slower than all7, 0.85 times); a bound of 1e-5
+//   needs (cluster_size, far_order, far_ratio) = (64, 4, 6) (2e-6 and 7e-6) or (32, 1, 10), where
+//   the gain is 1.2 times at most: with a cluster's far zone beginning 6 to 10 radii away, most of
+//   a 5120-triangle capsule is near every cluster, and the 7-point rule dominates. The adaptive rule
+//   therefore is not the default (a hierarchical, treecode-like far field would be needed).
+//   Every cluster that contains a corner at x_i lies within rho_c of x_i, so far_ratio > 1 keeps
+//   the triangles at x_i on the 7-point rule, which the singular correction below takes back.
 // - Triangles that contain x_i: polar coordinates (rho, phi) centred on x_i [118]. There
 //   G dS = (I + e e^T) / rho * rho drho dphi, the singularity cancels, and with f linear along
 //   each ray the radial integral is exact: int_0^rho_max f drho = rho_max (f(x_i) + f_edge(phi)) / 2.
@@ -16,6 +41,8 @@
 //   (sub-triangles at the singular vertex) of `angular_points` points each.
 // All quadrature points, weights and interpolated densities are precomputed once per evaluation
 // in structure-of-arrays form; the loop over targets runs in parallel (OpenMP).
+#include <cstdint>
+#include <string>
 #include <vector>
 
 #include "bendlab/core/types.hpp"
@@ -23,10 +50,22 @@
 
 namespace bendlab {
 
+/// all7: the 7-point rule on every non-singular triangle for every target (the reference, default);
+/// adaptive: the 7-point rule near the target, the moment-corrected centroid rule far from it.
+enum class SingleLayerQuadrature { all7, adaptive };
+
 struct SingleLayerOptions {
   int angular_points = 8;        ///< Gauss-Legendre points per sub-angle of a singular triangle
   int angular_subdivisions = 2;  ///< sub-angles per singular triangle
+  SingleLayerQuadrature quadrature = SingleLayerQuadrature::all7;
+  int cluster_size = 32;   ///< adaptive: triangles per cluster (>= 1)
+  int far_order = 1;       ///< adaptive: the far rule matches the cluster's moments up to this degree (0..4)
+  double far_ratio = 4.0;  ///< adaptive: far when |x_i - c_c| >= far_ratio * rho_c (> 1)
 };
+
+/// "all7" | "adaptive"; the inverse throws bendlab::Error naming the unknown value.
+std::string to_string(SingleLayerQuadrature q);
+SingleLayerQuadrature single_layer_quadrature(const std::string& name);
 
 class StokesSingleLayer {
  public:
@@ -37,13 +76,24 @@ class StokesSingleLayer {
   void velocity(const Points& x, const Points& f_density, double mu, Points& u) const;
 
   const Topology& topology() const { return *topology_; }
+  const SingleLayerOptions& options() const { return options_; }
 
  private:
+  void prepare(const Points& x, const Points& f) const;
+
   TopologyPtr topology_;
   SingleLayerOptions options_;
   std::vector<double> gl_nodes_, gl_weights_;  // Gauss-Legendre on [0, 1]
-  // Quadrature points (7 per face, face-major) and the density times the weight times the area.
+  // Per-evaluation buffers (prepared once per call, reused between calls).
+  // slot_[k]: the face at sorted position k (all7: k itself); position_[face] its inverse.
+  mutable std::vector<int> slot_, position_;
+  mutable std::vector<std::uint64_t> keys_;
+  // 7-point quadrature points (7 per face, in sorted order) and density times weight times area.
   mutable std::vector<double> qx_, qy_, qz_, fx_, fy_, fz_;
+  // adaptive: far-rule points (one per face, sorted order) and weights; clusters' centres, radii
+  // squared times far_ratio^2, and whether the far rule may be used.
+  mutable std::vector<double> px_, py_, pz_, pfx_, pfy_, pfz_;
+  mutable std::vector<double> cx_, cy_, cz_, far2_;
 };
 
 /// The 7-point degree-5 rule on a triangle: barycentric coordinates (of corners 0, 1, 2) and
