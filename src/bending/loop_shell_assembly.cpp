@@ -53,7 +53,8 @@ double shell_energy_mass(const LoopPatches& patches, const QuadratureBases& base
   double energy = 0.0;
 #pragma omp parallel reduction(+ : energy) if (patches.num_faces() >= parallel_faces)
   {
-    FaceLocal local;
+    FaceWork work;
+    FaceLocal local;  // the reference kernel, for valences without a fixed-size one
     local.with_mass = true;
     local.with_h = h_rhs != nullptr;
     for (int c = 0; c < colouring.num_colours(); ++c) {
@@ -63,9 +64,23 @@ double shell_energy_mass(const LoopPatches& patches, const QuadratureBases& base
       for (int k = colouring.offsets[c]; k < colouring.offsets[c + 1]; ++k) {
         const int f = colouring.faces[k];
         const int* idx = patches.face_points(f);
+        const int* slot = mass.face_slots(f);
+        if (face_energy_fast(bases, patches.valence[f], control, idx, kappa_b, h_rhs != nullptr, work, energy)) {
+          const int n = work.m;
+          const double* upper = work.mass;
+          for (int a = 0; a < n; ++a) {
+            for (int d = 0; d < 3; ++d) gradient(idx[a], d) += work.gradient[a][d];
+            values[slot[a * n + a]] += *upper++;
+            for (int b = a + 1; b < n; ++b, ++upper) {
+              values[slot[a * n + b]] += *upper;
+              values[slot[b * n + a]] += *upper;
+            }
+            if (h_rhs) (*h_rhs)[idx[a]] += work.h[a];
+          }
+          continue;
+        }
         energy += face_energy(bases.at(patches.valence[f]), rule, control, idx, kappa_b, &local);
         const int n = static_cast<int>(local.gradient.rows());
-        const int* slot = mass.face_slots(f);
         for (int a = 0; a < n; ++a) {
           gradient.row(idx[a]) += local.gradient.row(a);
           for (int b = 0; b < n; ++b) values[slot[a * n + b]] += local.mass(a, b);

@@ -8,20 +8,44 @@ namespace bendlab::loop_shell {
 
 namespace {
 
-// q = M p for symmetric column-major M: row i of M is its column i.
-void symmetric_product(const Eigen::SparseMatrix<double>& m, const Eigen::MatrixXd& p, Eigen::MatrixXd& q) {
+// q = M p for symmetric column-major M: row i of M is its column i. One pass over M's entries
+// for all columns of p at once (K of them; K = 0: p.cols() at run time).
+template <int K>
+void symmetric_product_k(const Eigen::SparseMatrix<double>& m, const Eigen::MatrixXd& p, Eigen::MatrixXd& q) {
   const int n = static_cast<int>(m.cols());
-  const int k = static_cast<int>(p.cols());
+  const int k = K > 0 ? K : static_cast<int>(p.cols());
   const int* outer = m.outerIndexPtr();
   const int* inner = m.innerIndexPtr();
   const double* values = m.valuePtr();
+  const double* pc = p.data();
+  double* qc = q.data();
 #pragma omp parallel for schedule(static) if (n > 2000)
-  for (int i = 0; i < n; ++i)
-    for (int c = 0; c < k; ++c) {
-      double s = 0.0;
-      for (int e = outer[i]; e < outer[i + 1]; ++e) s += values[e] * p(inner[e], c);
-      q(i, c) = s;
+  for (int i = 0; i < n; ++i) {
+    if constexpr (K > 0) {
+      double s[K] = {};
+      for (int e = outer[i]; e < outer[i + 1]; ++e) {
+        const double v = values[e];
+        const int j = inner[e];
+        for (int c = 0; c < K; ++c) s[c] += v * pc[j + c * n];
+      }
+      for (int c = 0; c < K; ++c) qc[i + c * n] = s[c];
+    } else {
+      for (int c = 0; c < k; ++c) {
+        double s = 0.0;
+        for (int e = outer[i]; e < outer[i + 1]; ++e) s += values[e] * pc[inner[e] + c * n];
+        qc[i + c * n] = s;
+      }
     }
+  }
+}
+
+void symmetric_product(const Eigen::SparseMatrix<double>& m, const Eigen::MatrixXd& p, Eigen::MatrixXd& q) {
+  switch (p.cols()) {
+    case 1: symmetric_product_k<1>(m, p, q); break;
+    case 3: symmetric_product_k<3>(m, p, q); break;
+    case 4: symmetric_product_k<4>(m, p, q); break;
+    default: symmetric_product_k<0>(m, p, q); break;
+  }
 }
 
 }  // namespace

@@ -79,6 +79,48 @@ TEST(LoopShellAssembly, FusedAssemblyEqualsTheSerialReference) {
   }
 }
 
+TEST(LoopShellAssembly, FixedSizeFaceKernelEqualsTheReferenceForEveryValence) {
+  // face_energy_fast (tabulated products, fixed sizes) against face_energy on one patch of each
+  // valence it serves, with random control points near a flat patch (positive area element).
+  std::vector<int> valences;
+  for (int n = 3; n <= FaceWork::kMaxFastValence; ++n) valences.push_back(n);
+  const QuadratureBases bases(dunavant_rule(6), valences);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-0.05, 0.05);
+  for (const int n : valences) {
+    const int m = n + 6;
+    Points p(m, 3);
+    // Any non-degenerate positions serve the comparison: a wavy spiral, perturbed.
+    for (int a = 0; a < m; ++a) p.row(a) << std::cos(0.7 * a) * (1 + 0.1 * a), std::sin(0.7 * a) * (1 + 0.1 * a),
+                                            0.2 * std::cos(1.3 * a) + u(rng);
+    std::vector<int> idx(m);
+    for (int a = 0; a < m; ++a) idx[a] = a;
+    FaceLocal local;
+    local.with_mass = local.with_h = true;
+    const double e_ref = face_energy(bases.at(n), bases.rule(), p, idx.data(), 1.7, &local);
+    FaceWork work;
+    double e = 0.0;
+    ASSERT_TRUE(face_energy_fast(bases, n, p, idx.data(), 1.7, true, work, e));
+    ASSERT_EQ(work.m, m);
+    EXPECT_NEAR(e, e_ref, 1e-13 * std::abs(e_ref)) << n;
+    const double gmax = local.gradient.cwiseAbs().maxCoeff(), mmax = local.mass.cwiseAbs().maxCoeff();
+    const double hmax = local.h.cwiseAbs().maxCoeff();
+    int k = 0;
+    for (int a = 0; a < m; ++a) {
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(work.gradient[a][c], local.gradient(a, c), 1e-12 * gmax) << n;
+      for (int b = a; b < m; ++b) EXPECT_NEAR(work.mass[k++], local.mass(a, b), 1e-14 * mmax) << n;
+      EXPECT_NEAR(work.h[a], local.h[a], 1e-13 * hmax) << n;
+    }
+  }
+  // Valences beyond the fixed-size kernels are left to the reference.
+  const QuadratureBases wide(dunavant_rule(6), {FaceWork::kMaxFastValence + 1});
+  FaceWork work;
+  double e = 0.0;
+  const Points p = Points::Zero(FaceWork::kMaxFastValence + 7, 3);
+  std::vector<int> idx(FaceWork::kMaxFastValence + 7, 0);
+  EXPECT_FALSE(face_energy_fast(wide, FaceWork::kMaxFastValence + 1, p, idx.data(), 1.0, false, work, e));
+}
+
 TEST(LoopShellAssembly, GradientAndMassDoNotDependOnTheThreadCount) {
   const ShellSetup s(sphere_mesh(MeshFamily::MT1, 2));
   const int before = omp_get_max_threads();

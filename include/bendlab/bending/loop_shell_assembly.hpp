@@ -1,8 +1,10 @@
 #pragma once
 // Method S (paper section 2.5): one pass over the quadrature points that yields everything an
 // evaluation needs from the control points P: E_B, dE_B/dP (loop_shell_energy.hpp), the values of
-// the consistent mass matrix M (loop_shell_mass.hpp) and optionally int N_I H dA. The serial
-// functions shell_energy() and MassPattern::assemble() stay the reference (tested equal).
+// the consistent mass matrix M (loop_shell_mass.hpp) and optionally int N_I H dA. Each patch goes
+// through face_energy_fast (fixed-size products, tabulated N_a N_b; loop_shell_energy.hpp), or
+// face_energy for a valence above FaceWork::kMaxFastValence. The serial functions shell_energy()
+// and MassPattern::assemble() stay the reference (tested equal).
 //
 // Parallel without conflicts: the faces are coloured so that no two faces of one colour share a
 // control point (FaceColouring); the faces of one colour are evaluated by all OpenMP threads and
