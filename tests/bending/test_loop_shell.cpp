@@ -1,6 +1,8 @@
 // Method S (paper section 2.5, METHOD_S.md): patches on meshes, energy, gradient, forces, options.
 #include <gtest/gtest.h>
 
+#include <Eigen/SparseLU>
+
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -129,6 +131,20 @@ TEST(LoopShell, LimitMasksEqualPatchEvaluationAtTheCorners) {
       EXPECT_LT((s.x - row(limit, vtx)).norm(), ev ? 1e-8 : 1e-13) << f << " " << c;
       EXPECT_LT((s.n - row(normals, vtx)).norm(), ev ? 1e-4 : 1e-12) << f << " " << c;
     }
+}
+
+TEST(LoopShell, SymmetricLimitSolveEqualsTheLuSolveOfL) {
+  // LimitSolver (LDL^T of the symmetric S, L = diag(chi) S) against a plain LU of L, on meshes
+  // with extraordinary vertices of valence 4 and 5.
+  for (const TriMesh& m : {sphere_mesh(MeshFamily::MT1, 2), sphere_mesh(MeshFamily::Octa, 2)}) {
+    const Topology& t = m.topology();
+    const Points x = perturbed(make_rbc(1.0)->map_from_unit_sphere(m.positions()), 0.01, 3);
+    Eigen::SparseLU<Eigen::SparseMatrix<double>> lu(limit_matrix(t));
+    const Eigen::MatrixXd ref = lu.solve(Eigen::MatrixXd(x));
+    const Points p = LimitSolver(t).solve(x);
+    EXPECT_LE((p - ref).cwiseAbs().maxCoeff(), 1e-12 * ref.cwiseAbs().maxCoeff());
+    EXPECT_LE((limit_matrix(t) * p - x).cwiseAbs().maxCoeff(), 1e-13);
+  }
 }
 
 TEST(LoopShell, SphereEnergyTendsToEightPiKappa) {
