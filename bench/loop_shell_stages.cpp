@@ -99,7 +99,7 @@ int main(int argc, char** argv) {
     iterations.push_back(it);
     Points fd;
     s_nodal.push_back(seconds([&] { fd = limit * fc; }));
-    s_area.push_back(seconds([&] { (void)MeshGeometry::compute(t, x).mixed_area.sum(); }));
+    s_area.push_back(seconds([&] { (void)mixed_area(t, x).sum(); }));
     s_total.push_back(seconds([&] { s->forces(t, x, 1.0, force); }));
     c_total.push_back(seconds([&] { c->forces(t, x, 1.0, force); }));
   }

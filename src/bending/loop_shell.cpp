@@ -164,7 +164,7 @@ BendingResult LoopShellMethod::evaluate(const Topology& topology, const Points& 
   const Eigen::MatrixXd solution = solve_mass(*cache, m, rhs);
   const Eigen::MatrixXd fc = solution.leftCols(3);
   r.force_density = cache->limit * fc;
-  r.area = MeshGeometry::compute(topology, x).mixed_area;
+  r.area = mixed_area(topology, x);
   r.force = r.force_density.array().colwise() * r.area.array();
   const double nan = std::numeric_limits<double>::quiet_NaN();
   r.lapH = Scalars::Constant(nv, nan);

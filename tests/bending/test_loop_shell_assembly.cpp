@@ -137,6 +137,22 @@ TEST(LoopShellAssembly, GradientAndMassDoNotDependOnTheThreadCount) {
   EXPECT_EQ(Eigen::MatrixXd(m1), Eigen::MatrixXd(m2));
 }
 
+TEST(LoopShellAssembly, ForcesOnOneAndTwoThreadsAgree) {
+  // 5120 triangles: above kParallelFaces, so the coloured assembly and the CG products run on the
+  // threads. Fresh method objects: both solves start cold.
+  const TriMesh mesh = sphere_mesh(MeshFamily::MT1, 4);
+  ASSERT_GE(mesh.num_faces(), kParallelFaces);
+  const Points x = make_rbc(1.0)->map_from_unit_sphere(mesh.positions());
+  const int before = omp_get_max_threads();
+  Points f1, f2;
+  omp_set_num_threads(1);
+  LoopShellMethod::create({})->forces(mesh.topology(), x, 1.0, f1);
+  omp_set_num_threads(2);
+  LoopShellMethod::create({})->forces(mesh.topology(), x, 1.0, f2);
+  omp_set_num_threads(before);
+  EXPECT_LE((f1 - f2).cwiseAbs().maxCoeff(), 1e-13 * f1.cwiseAbs().maxCoeff());
+}
+
 TEST(LoopShellAssembly, WarmStartedSolveMeetsTheSameTolerance) {
   const ShellSetup s(sphere_mesh(MeshFamily::MT1, 2));
   Points g;
