@@ -112,8 +112,8 @@ int main(int argc, char** argv) {
   }
   fmt::print("Method S stages, {} triangles, {} vertices (processor ms per call, median of {})\n", t.num_faces(),
              t.num_vertices(), repeats);
-  fmt::print("set-up: patches {:.3f}, quadrature bases {:.3f}, mass pattern {:.3f}, colouring {:.3f}, L + LDLT of S {:.3f}\n",
-             1e3 * t_patches, 1e3 * t_bases, 1e3 * t_mass_pattern, 1e3 * t_colouring, 1e3 * t_limit_lu);
+  fmt::print("set-up: patches {:.3f}, quadrature bases {:.3f}, mass pattern {:.3f}, colouring {:.3f} ({} colours), L + LDLT of S {:.3f}\n",
+             1e3 * t_patches, 1e3 * t_bases, 1e3 * t_mass_pattern, 1e3 * t_colouring, colouring.num_colours(), 1e3 * t_limit_lu);
   fmt::print("control L P = X {:.3f}\nmass pattern copy {:.3f}\nenergy+gradient+M {:.3f}\n", 1e3 * median(s_control),
              1e3 * median(s_copy), 1e3 * median(s_assembly));
   fmt::print("(reference energy+gradient, then M: {:.3f})\n", 1e3 * median(s_reference));

@@ -41,17 +41,27 @@ struct ShellSetup {
 
 TEST(LoopShellAssembly, ColoursSeparatePatchesAndCoverEveryFace) {
   const ShellSetup s(sphere_mesh(MeshFamily::Octa, 2));
-  std::vector<int> seen(s.patches.num_faces(), 0);
-  for (int c = 0; c < s.colouring.num_colours(); ++c) {
-    std::set<int> points;
-    for (int k = s.colouring.offsets[c]; k < s.colouring.offsets[c + 1]; ++k) {
-      const int f = s.colouring.faces[k];
-      ++seen[f];
-      for (int a = 0; a < s.patches.valence[f] + 6; ++a)
-        EXPECT_TRUE(points.insert(s.patches.face_points(f)[a]).second) << "colour " << c << " face " << f;
+  // Blocks of faces (default) and single faces.
+  for (const FaceColouring& colouring :
+       {s.colouring, FaceColouring::build(s.patches, s.mesh.num_vertices(), 1)}) {
+    std::vector<int> seen(s.patches.num_faces(), 0);
+    ASSERT_EQ(colouring.blocks.back(), s.patches.num_faces());
+    for (int c = 0; c < colouring.num_colours(); ++c) {
+      // Blocks of one colour share no control point; they cover the colour's faces.
+      std::set<int> points;
+      EXPECT_EQ(colouring.blocks[colouring.block_offsets[c]], colouring.offsets[c]);
+      for (int j = colouring.block_offsets[c]; j < colouring.block_offsets[c + 1]; ++j) {
+        std::set<int> block;
+        for (int k = colouring.blocks[j]; k < colouring.blocks[j + 1]; ++k) {
+          const int f = colouring.faces[k];
+          ++seen[f];
+          for (int a = 0; a < s.patches.valence[f] + 6; ++a) block.insert(s.patches.face_points(f)[a]);
+        }
+        for (const int p : block) EXPECT_TRUE(points.insert(p).second) << "colour " << c << " block " << j;
+      }
     }
+    for (int f = 0; f < s.patches.num_faces(); ++f) EXPECT_EQ(seen[f], 1) << f;
   }
-  for (int f = 0; f < s.patches.num_faces(); ++f) EXPECT_EQ(seen[f], 1) << f;
 }
 
 TEST(LoopShellAssembly, FusedAssemblyEqualsTheSerialReference) {
