@@ -148,19 +148,38 @@ TEST(LoopShellAssembly, GradientAndMassDoNotDependOnTheThreadCount) {
 }
 
 TEST(LoopShellAssembly, ForcesOnOneAndTwoThreadsAgree) {
-  // 5120 triangles: above kParallelFaces, so the coloured assembly and the CG products run on the
-  // threads. Fresh method objects: both solves start cold.
+  // 5120 triangles: above kParallelFaces, so the coloured assembly runs on the threads (and the
+  // rest of the pipeline). One method object with the exact solver, so that its per-topology
+  // set-up is paid once; the CG solve's thread independence is the next test.
   const TriMesh mesh = sphere_mesh(MeshFamily::MT1, 4);
   ASSERT_GE(mesh.num_faces(), kParallelFaces);
   const Points x = make_rbc(1.0)->map_from_unit_sphere(mesh.positions());
+  const auto exact = LoopShellMethod::create({{"solver", "ldlt"}});
   const int before = omp_get_max_threads();
   Points f1, f2;
   omp_set_num_threads(1);
-  LoopShellMethod::create({})->forces(mesh.topology(), x, 1.0, f1);
+  exact->forces(mesh.topology(), x, 1.0, f1);
   omp_set_num_threads(2);
-  LoopShellMethod::create({})->forces(mesh.topology(), x, 1.0, f2);
+  exact->forces(mesh.topology(), x, 1.0, f2);
   omp_set_num_threads(before);
   EXPECT_LE((f1 - f2).cwiseAbs().maxCoeff(), 1e-13 * f1.cwiseAbs().maxCoeff());
+}
+
+TEST(LoopShellAssembly, MassSolveOnOneAndTwoThreadsAgrees) {
+  // The CG products over the threads (parallel_rows = 0: whatever the size); the same iterates.
+  const ShellSetup s(sphere_mesh(MeshFamily::MT1, 2));
+  Points g;
+  Eigen::SparseMatrix<double> m = s.mass.pattern();
+  shell_energy_mass(s.patches, s.bases, s.mass, s.colouring, s.control, 1.0, g, m);
+  const int before = omp_get_max_threads();
+  int it1 = 0, it2 = 0;
+  omp_set_num_threads(1);
+  const Eigen::MatrixXd x1 = solve_mass_cg(m, g, 1e-10, 1000, &it1, nullptr, 0);
+  omp_set_num_threads(2);
+  const Eigen::MatrixXd x2 = solve_mass_cg(m, g, 1e-10, 1000, &it2, nullptr, 0);
+  omp_set_num_threads(before);
+  EXPECT_EQ(it1, it2);
+  EXPECT_LE((x1 - x2).cwiseAbs().maxCoeff(), 1e-13 * x1.cwiseAbs().maxCoeff());
 }
 
 TEST(LoopShellAssembly, WarmStartedSolveMeetsTheSameTolerance) {
