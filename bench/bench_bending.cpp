@@ -83,7 +83,7 @@ void BM_Forces(benchmark::State& state, const std::string& method) {
   for (Eigen::Index i = 0; i < moved.rows(); ++i) moved.row(i) *= 1.0 + 1e-3 * std::sin(3.0 * moved(i, 0));
   const Points* shapes[2] = {&mesh.positions(), &moved};
   int k = 0;
-  // Untimed: what a method sets up once per topology (S: patches, LU of L, mass pattern), as a
+  // Untimed: what a method sets up once per topology (S: patches, factorisation of L, mass pattern), as a
   // flow run pays it once.
   m->forces(mesh.topology(), moved, 1.0, force);
   for (auto _ : state) {

@@ -441,7 +441,7 @@ def main():
     md.append("Wall-clock seconds of one `BendingMethod::compute` (every quantity of a method), one run, on the "
               "machine that generated this page. The machine was shared and the methods use OpenMP, so times "
               "below about 0.1 s are dominated by thread scheduling; compare the largest meshes. Method S's times include "
-              "its set-up for a new topology (patches, LU factorisation of the limit-mask matrix L, mass-matrix "
+              "its set-up for a new topology (patches, factorisation of the limit-mask matrix L, mass-matrix "
               "pattern, face colouring), which a flow run pays once; its cost per force evaluation is measured "
               "by bench/bench_bending.cpp (docs/design.md). n/a: the method refused the mesh.\n")
     timings = study["timings"]

@@ -1,10 +1,10 @@
 #include "bendlab/bending/loop_shell.hpp"
 
 #include <Eigen/SparseCholesky>
-#include <Eigen/SparseLU>
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <set>
 
 #include "bendlab/bending/loop_shell_assembly.hpp"
@@ -39,10 +39,7 @@ struct LoopShellMethod::Cache {
         limit(loop_shell::limit_matrix(t)),
         mass(patches, t.num_vertices()),
         colouring(loop_shell::FaceColouring::build(patches, t.num_vertices())) {
-    if (solve_control) {
-      limit_lu.compute(limit);
-      if (limit_lu.info() != Eigen::Success) throw Error("method S: the limit-mask matrix L is singular");
-    }
+    if (solve_control) limit_solver.emplace(t);
     if (factorize_mass) mass_ldlt.analyzePattern(mass.pattern());
   }
   bool matches(const Topology& t) const { return t.num_vertices() == num_vertices && t.faces() == faces; }
@@ -59,7 +56,7 @@ struct LoopShellMethod::Cache {
   // from it. Successive shapes of a flow run differ little, so this saves most iterations; the
   // result still meets the same residual tolerance.
   Eigen::MatrixXd last_solution;
-  Eigen::SparseLU<SparseMatrix> limit_lu;
+  std::optional<loop_shell::LimitSolver> limit_solver;
   Eigen::SimplicialLDLT<SparseMatrix> mass_ldlt;
 };
 
@@ -127,9 +124,7 @@ Points LoopShellMethod::control_points(const Topology& topology, const Points& x
                 std::to_string(topology.num_vertices()) + " vertices");
   if (control_ == Control::Nodes) return x;
   auto cache = cache_for(topology);
-  std::lock_guard<std::mutex> lock(cache->mutex);
-  Eigen::MatrixXd p = cache->limit_lu.solve(Eigen::MatrixXd(x));
-  return p;
+  return cache->limit_solver->solve(x);
 }
 
 double LoopShellMethod::control_energy(const Topology& topology, const Points& control, double kappa_b,
@@ -169,7 +164,7 @@ BendingResult LoopShellMethod::evaluate(const Topology& topology, const Points& 
   const Eigen::MatrixXd solution = solve_mass(*cache, m, rhs);
   const Eigen::MatrixXd fc = solution.leftCols(3);
   r.force_density = cache->limit * fc;
-  r.area = MeshGeometry::compute(topology, x).mixed_area;
+  r.area = mixed_area(topology, x);
   r.force = r.force_density.array().colwise() * r.area.array();
   const double nan = std::numeric_limits<double>::quiet_NaN();
   r.lapH = Scalars::Constant(nv, nan);

@@ -24,6 +24,26 @@ Eigen::SparseMatrix<double> limit_matrix(const Topology& t) {
   return l;
 }
 
+LimitSolver::LimitSolver(const Topology& t) : inv_chi_(t.num_vertices()) {
+  std::vector<Eigen::Triplet<double>> triplets;
+  triplets.reserve(t.ring_vertices().size() + t.num_vertices());
+  for (int i = 0; i < t.num_vertices(); ++i) {
+    const int n = t.valence(i);
+    inv_chi_[i] = 1.0 / limit_ring_weight(n);
+    triplets.emplace_back(i, i, inv_chi_[i] - n);
+    for (int k = t.ring_begin(i); k < t.ring_end(i); ++k) triplets.emplace_back(i, t.ring_vertices()[k], 1.0);
+  }
+  Eigen::SparseMatrix<double> s(t.num_vertices(), t.num_vertices());
+  s.setFromTriplets(triplets.begin(), triplets.end());
+  ldlt_.compute(s);
+  if (ldlt_.info() != Eigen::Success) throw Error("method S: the limit-mask matrix L is singular");
+}
+
+Points LimitSolver::solve(const Points& x) const {
+  const Eigen::MatrixXd p = ldlt_.solve(inv_chi_.asDiagonal() * Eigen::MatrixXd(x));
+  return p;
+}
+
 Points limit_normals(const Topology& t, const Points& p) {
   Points normal(t.num_vertices(), 3);
   for (int i = 0; i < t.num_vertices(); ++i) {

@@ -94,6 +94,43 @@ MeshGeometry MeshGeometry::compute(const Topology& t, const Points& x) {
   return g;
 }
 
+Scalars mixed_area(const Topology& t, const Points& x) {
+  const int nf = t.num_faces(), nv = t.num_vertices();
+  const Faces& F = t.faces();
+  // The arithmetic of MeshGeometry::compute, step for step.
+  CornerValues corner_mixed(nf, 3);
+#pragma omp parallel for schedule(static)
+  for (int f = 0; f < nf; ++f) {
+    const Vec3 p[3] = {x.row(F(f, 0)), x.row(F(f, 1)), x.row(F(f, 2))};
+    const double two_area = (p[1] - p[0]).cross(p[2] - p[0]).norm();
+    const double face_area = 0.5 * two_area;
+    double cot[3], l2[3];
+    for (int k = 0; k < 3; ++k) {
+      const Vec3 u = p[(k + 1) % 3] - p[k], w = p[(k + 2) % 3] - p[k];
+      cot[k] = u.dot(w) / two_area;
+      l2[k] = (p[(k + 2) % 3] - p[(k + 1) % 3]).squaredNorm();
+    }
+    int obtuse = -1;
+    for (int k = 0; k < 3; ++k)
+      if (cot[k] < 0) obtuse = k;
+    for (int k = 0; k < 3; ++k) {
+      const int k1 = (k + 1) % 3, k2 = (k + 2) % 3;
+      corner_mixed(f, k) = obtuse < 0 ? (l2[k2] * cot[k2] + l2[k1] * cot[k1]) / 8.0
+                                      : (k == obtuse ? 0.5 : 0.25) * face_area;
+    }
+  }
+  const auto& rf = t.ring_faces();
+  const auto& rc = t.ring_corners();
+  Scalars area(nv);
+#pragma omp parallel for schedule(static)
+  for (int i = 0; i < nv; ++i) {
+    double mixed = 0;
+    for (int r = t.ring_begin(i); r < t.ring_end(i); ++r) mixed += corner_mixed(rf[r], rc[r]);
+    area[i] = mixed;
+  }
+  return area;
+}
+
 Scalars cotan_laplacian(const Topology& t, const MeshGeometry& g, const Scalars& w, const Scalars& area) {
   const int nv = t.num_vertices();
   Scalars out(nv);

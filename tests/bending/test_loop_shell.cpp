@@ -1,6 +1,8 @@
 // Method S (paper section 2.5, METHOD_S.md): patches on meshes, energy, gradient, forces, options.
 #include <gtest/gtest.h>
 
+#include <Eigen/SparseLU>
+
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -10,6 +12,7 @@
 #include "bendlab/bending/loop_shell_limit.hpp"
 #include "bendlab/bending/loop_shell_mass.hpp"
 #include "bendlab/bending/loop_shell_patches.hpp"
+#include "bendlab/geometry/mesh_geometry.hpp"
 #include "bendlab/mesh/generators.hpp"
 #include "bendlab/surfaces/analytic_surface.hpp"
 
@@ -131,6 +134,20 @@ TEST(LoopShell, LimitMasksEqualPatchEvaluationAtTheCorners) {
     }
 }
 
+TEST(LoopShell, SymmetricLimitSolveEqualsTheLuSolveOfL) {
+  // LimitSolver (LDL^T of the symmetric S, L = diag(chi) S) against a plain LU of L, on meshes
+  // with extraordinary vertices of valence 4 and 5.
+  for (const TriMesh& m : {sphere_mesh(MeshFamily::MT1, 2), sphere_mesh(MeshFamily::Octa, 2)}) {
+    const Topology& t = m.topology();
+    const Points x = perturbed(make_rbc(1.0)->map_from_unit_sphere(m.positions()), 0.01, 3);
+    Eigen::SparseLU<Eigen::SparseMatrix<double>> lu(limit_matrix(t));
+    const Eigen::MatrixXd ref = lu.solve(Eigen::MatrixXd(x));
+    const Points p = LimitSolver(t).solve(x);
+    EXPECT_LE((p - ref).cwiseAbs().maxCoeff(), 1e-12 * ref.cwiseAbs().maxCoeff());
+    EXPECT_LE((limit_matrix(t) * p - x).cwiseAbs().maxCoeff(), 1e-13);
+  }
+}
+
 TEST(LoopShell, SphereEnergyTendsToEightPiKappa) {
   const TriMesh m = sphere_mesh(MeshFamily::MT1, 4);  // 5120 triangles
   const auto s = LoopShellMethod::create({});
@@ -234,6 +251,35 @@ TEST(LoopShell, ConjugateGradientsAgreeWithTheFactorisation) {
   const double scale = ldlt.force_density.cwiseAbs().maxCoeff();
   EXPECT_LT((cg.force_density - ldlt.force_density).cwiseAbs().maxCoeff(), 1e-8 * scale);
   EXPECT_LT((cg.H - ldlt.H).cwiseAbs().maxCoeff(), 1e-8);
+}
+
+TEST(LoopShell, ForcesEqualTheReferencePipeline) {
+  // The whole force with the exact solver (solver=ldlt) against the same steps done by the
+  // plain reference pieces: LU of L, the serial shell_energy and MassPattern::assemble, a sparse
+  // LDL^T of M, Meyer's area from MeshGeometry::compute. Valences 4, 5 and 6.
+  for (const TriMesh& m : {sphere_mesh(MeshFamily::MT1, 2), sphere_mesh(MeshFamily::Octa, 2)}) {
+    const Topology& t = m.topology();
+    const Points x = perturbed(make_rbc(1.0)->map_from_unit_sphere(m.positions()), 0.005, 5);
+    Points force;
+    LoopShellMethod::create({{"solver", "ldlt"}})->forces(t, x, 1.3, force);
+
+    const Eigen::SparseMatrix<double> l = limit_matrix(t);
+    Eigen::SparseLU<Eigen::SparseMatrix<double>> lu(l);
+    const Eigen::MatrixXd pc = lu.solve(Eigen::MatrixXd(x));
+    const Points control = pc;
+    const LoopPatches patches = LoopPatches::build(t);
+    const QuadratureBases bases(dunavant_rule(6), {4, 5, 6});
+    Points gradient;
+    shell_energy(patches, bases, control, 1.3, &gradient);
+    const MassPattern mass(patches, t.num_vertices());
+    Eigen::SparseMatrix<double> mm = mass.pattern();
+    mass.assemble(patches, bases, control, mm);
+    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(mm);
+    const Eigen::MatrixXd fc = ldlt.solve(-Eigen::MatrixXd(gradient));
+    const Eigen::MatrixXd density = l * fc;
+    const Points ref = density.array().colwise() * MeshGeometry::compute(t, x).mixed_area.array();
+    EXPECT_LE((force - ref).cwiseAbs().maxCoeff(), 1e-12 * ref.cwiseAbs().maxCoeff());
+  }
 }
 
 TEST(LoopShell, IcosahedronIsRefusedNamingAFace) {

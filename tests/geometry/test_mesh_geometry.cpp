@@ -60,6 +60,14 @@ TEST(MeshGeometry, MixedAreasTileTheSurface) {
   EXPECT_GT(obtuse_total, 0) << "the families should include obtuse triangles";
 }
 
+TEST(MeshGeometry, MixedAreaAloneEqualsTheFullPassBitForBit) {
+  // Every family, obtuse triangles included (the RBC and Rivara meshes).
+  for (const auto& c : all_families()) {
+    const auto g = MeshGeometry::compute(c.mesh.topology(), c.mesh.positions());
+    EXPECT_EQ(mixed_area(c.mesh.topology(), c.mesh.positions()), g.mixed_area) << c.label;
+  }
+}
+
 TEST(MeshGeometry, VoronoiEqualsMixedWithoutObtuseTriangles) {
   const TriMesh m = sphere_mesh(MeshFamily::MT1, 3);
   const auto g = MeshGeometry::compute(m.topology(), m.positions());

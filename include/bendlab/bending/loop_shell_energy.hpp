@@ -27,10 +27,15 @@ class QuadratureBases {
   const TriangleRule& rule() const { return rule_; }
   /// Bases at the rule's points for patches of EV valence n (one of the valences given).
   const std::vector<PatchBasis>& at(int valence) const;
+  /// The products N_a N_b of the shape functions at the rule's points for valence n: row k for
+  /// the k-th pair a <= b of the upper triangle read row by row, column q for point q; so that a
+  /// patch's mass block is this matrix times (w_q J_q / 2) (face_energy_fast).
+  const Eigen::MatrixXd& mass_products(int valence) const;
 
  private:
   TriangleRule rule_;
   std::vector<std::vector<PatchBasis>> by_valence_;  // index: valence
+  std::vector<Eigen::MatrixXd> mass_products_;      // index: valence
 };
 
 /// The limit surface at one parameter point of one patch.
@@ -53,6 +58,25 @@ struct FaceLocal {
 };
 double face_energy(const std::vector<PatchBasis>& basis, const TriangleRule& rule, const Points& control,
                    const int* idx, double kappa_b, FaceLocal* local);
+
+/// What face_energy_fast returns for one patch of m = N + 6 control points: its rows of dE_B/dP
+/// (patch order), its mass block int N_a N_b dA as the upper triangle (pairs a <= b, row by row)
+/// and int N_a H dA.
+struct FaceWork {
+  /// Largest patch with a fixed-size kernel: EV valence 3 .. kMaxFastValence.
+  static constexpr int kMaxFastValence = 8;
+  static constexpr int kMax = kMaxFastValence + 6;
+  int m = 0;
+  double gradient[kMax][3];
+  double mass[kMax * (kMax + 1) / 2];
+  double h[kMax];
+};
+/// The same sums as face_energy (the reference; equal to round-off, tested) for a patch of EV
+/// valence 3 .. FaceWork::kMaxFastValence: fixed-size products on the tabulated bases, the mass
+/// block from QuadratureBases::mass_products, no heap allocation. Returns false (and does
+/// nothing) for another valence. Adds the patch's E_B to `energy`; h only if with_h.
+bool face_energy_fast(const QuadratureBases& bases, int valence, const Points& control, const int* idx,
+                      double kappa_b, bool with_h, FaceWork& work, double& energy);
 
 /// E_B = 2 kB int H^2 dA over the limit surface with the rule of `bases`; if gradient is not
 /// null it is resized to P's shape and receives dE_B/dP (so F = -gradient).

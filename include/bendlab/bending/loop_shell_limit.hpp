@@ -10,6 +10,7 @@
 //                   (the surface is only C1 there): the mean over the incident patches at
 //                   v = w = 1e-3 (the EV corner is u = 1) is reported.
 #include <Eigen/Sparse>
+#include <Eigen/SparseCholesky>
 
 #include "bendlab/bending/loop_shell_patches.hpp"
 #include "bendlab/core/types.hpp"
@@ -23,6 +24,20 @@ inline constexpr double kExtraordinarySample = 1e-3;
 /// The limit-mask matrix L (N x N, row i: 1 - N_i chi at i, chi at each ring vertex), so that
 /// L P gives the limit points of control points P. Rows sum to 1.
 Eigen::SparseMatrix<double> limit_matrix(const Topology& topology);
+
+/// Solves L P = X for the control points P whose limit points are X. L = C S with C = diag(chi_i)
+/// and S symmetric (S_ij = 1 for ring neighbours, S_ii = 1 / chi_i - N_i); S is positive definite
+/// (C^1/2 S C^1/2 is similar to L, whose eigenvalues lie in [1/4, 1]), so P = S^-1 C^-1 X by a
+/// sparse LDL^T of S, factorised once per topology. Equal to an LU solve of L to round-off (tested).
+class LimitSolver {
+ public:
+  explicit LimitSolver(const Topology& topology);
+  Points solve(const Points& x) const;
+
+ private:
+  Eigen::VectorXd inv_chi_;
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt_;
+};
 
 /// Outward unit normals of the limit surface at the limit points of the nodes.
 Points limit_normals(const Topology& topology, const Points& control);

@@ -11,10 +11,12 @@ namespace bendlab::loop_shell {
 /// Solves M X = B for every column of B at once (one pass over M per iteration) with
 /// Jacobi-preconditioned CG from X = x0 (a previous solution: warm start; zero if null or of
 /// another shape), to |B_c - M X_c| <= tolerance |B_c| per column. The products M p run over the
-/// OpenMP threads (row i from column i, M being symmetric: no conflicts, thread-count independent).
+/// OpenMP threads from parallel_rows rows on (row i from column i, M being symmetric: no conflicts,
+/// thread-count independent).
 /// `iterations` (if not null) receives the count. Throws bendlab::Error if max_iterations do not
 /// suffice. M must be symmetric positive definite with both triangles stored.
 Eigen::MatrixXd solve_mass_cg(const Eigen::SparseMatrix<double>& m, const Eigen::MatrixXd& b, double tolerance,
-                              int max_iterations, int* iterations = nullptr, const Eigen::MatrixXd* x0 = nullptr);
+                              int max_iterations, int* iterations = nullptr, const Eigen::MatrixXd* x0 = nullptr,
+                              int parallel_rows = 2000);
 
 }  // namespace bendlab::loop_shell

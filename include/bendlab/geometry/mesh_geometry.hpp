@@ -34,6 +34,10 @@ struct MeshGeometry {
   static MeshGeometry compute(const Topology& topology, const Points& x);
 };
 
+/// Meyer's mixed area alone: MeshGeometry::compute(topology, x).mixed_area, bit for bit (tested),
+/// without the angles, normals and edge weights (for methods that need only the area, e.g. S).
+Scalars mixed_area(const Topology& topology, const Points& x);
+
 /// Cotangent Laplace-Beltrami of a per-vertex scalar, with the div-grad sign (negative
 /// semidefinite): (Lap w)_i = 1/(2 A_i) sum_j T_ij (w_j - w_i), eq. (11) with A_i = area(i).
 /// With area = mixed_area this is Meyer's operator; with voronoi_area it is eq. (7).
