@@ -9,24 +9,8 @@ namespace bendlab {
 NeoHookean::NeoHookean(TopologyPtr topology, const Points& reference, double kS)
     : topology_(std::move(topology)), kS_(kS) {
   if (!(kS > 0) || !std::isfinite(kS)) throw Error(fmt::format("neo-Hookean: kS must be positive, got {}", kS));
-  const Topology& t = *topology_;
-  if (reference.rows() != t.num_vertices())
-    throw Error(fmt::format("neo-Hookean: {} reference positions for {} vertices", reference.rows(), t.num_vertices()));
-  const int nf = t.num_faces();
-  a0_.resize(nf); m00_.resize(nf); m01_.resize(nf); m11_.resize(nf);
-  const Faces& F = t.faces();
-  for (int f = 0; f < nf; ++f) {
-    const Vec3 x0 = row(reference, F(f, 0));
-    const Vec3 e1 = row(reference, F(f, 1)) - x0, e2 = row(reference, F(f, 2)) - x0;
-    const double g00 = e1.dot(e1), g01 = e1.dot(e2), g11 = e2.dot(e2);
-    const double det = g00 * g11 - g01 * g01;  // = (2 A0)^2
-    if (!(det > 0)) throw Error(fmt::format("neo-Hookean: reference triangle {} has zero area", f));
-    a0_[f] = 0.5 * std::sqrt(det);
-    m00_[f] = g11 / det;
-    m01_[f] = -g01 / det;
-    m11_[f] = g00 / det;
-    reference_area_ += a0_[f];
-  }
+  flat_triangle_reference(*topology_, reference, "neo-Hookean", a0_, m00_, m01_, m11_);
+  for (const double a : a0_) reference_area_ += a;
 }
 
 double NeoHookean::energy(const Points& x) const {
@@ -73,22 +57,7 @@ double NeoHookean::energy_and_forces(const Points& x, Points& force) const {
     grad1.row(f) = d1.transpose();
     grad2.row(f) = d2.transpose();
   }
-  // Gather per vertex over its one-ring faces (CSR), so no two threads write one vertex.
-  const auto& rf = t.ring_faces();
-  const auto& rc = t.ring_corners();
-#pragma omp parallel for schedule(static)
-  for (int i = 0; i < nv; ++i) {
-    Eigen::RowVector3d g = Eigen::RowVector3d::Zero();
-    for (int k = t.ring_begin(i); k < t.ring_end(i); ++k) {
-      const int f = rf[k];
-      switch (rc[k]) {
-        case 0: g -= grad1.row(f) + grad2.row(f); break;
-        case 1: g += grad1.row(f); break;
-        default: g += grad2.row(f); break;
-      }
-    }
-    force.row(i) = -g;
-  }
+  gather_corner_gradients(t, grad1, grad2, force);
   return c * e;
 }
 

@@ -31,6 +31,17 @@ class ElasticLaw {
   virtual double energy_and_forces(const Points& x, Points& force) const = 0;
 };
 
+/// The reference state shared by the laws on flat linear triangles: per face the reference area
+/// a0 and the inverse reference metric (m00, m01, m11) of the edges e1 = x1 - x0, e2 = x2 - x0.
+/// Throws bendlab::Error naming `law` for a reference of the wrong size or a zero-area triangle.
+void flat_triangle_reference(const Topology& topology, const Points& reference, const char* law, Scalars& a0,
+                             Scalars& m00, Scalars& m01, Scalars& m11);
+
+/// force.row(i) = -(sum over the faces of vertex i of dE/dx_i), from the per-face gradients with
+/// respect to corners 1 and 2 (grad1, grad2; corner 0's is minus their sum). Gathered per vertex
+/// over its one-ring (CSR), so no two threads write one vertex.
+void gather_corner_gradients(const Topology& topology, const Points& grad1, const Points& grad2, Points& force);
+
 /// The names make_elastic_law() accepts: {"neo-hookean", "skalak"}.
 std::vector<std::string> elastic_law_names();
 
