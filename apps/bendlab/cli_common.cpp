@@ -7,11 +7,6 @@
 
 namespace bendlab::cli {
 
-void require_positive(const std::string& option, double value, bool allow_zero) {
-  if (!std::isfinite(value) || value < 0 || (!allow_zero && value == 0))
-    throw Error(fmt::format("{} must be a finite number {} 0, got {}", option, allow_zero ? ">=" : ">", value));
-}
-
 std::string extension_of(const std::filesystem::path& path) {
   std::string ext = path.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });

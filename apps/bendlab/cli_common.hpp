@@ -6,12 +6,12 @@
 #include <string>
 #include <vector>
 
+#include "bendlab/core/finite_check.hpp"
 #include "bendlab/surfaces/analytic_surface.hpp"
 
 namespace bendlab::cli {
 
-/// Throws unless value is finite and > 0 (or >= 0 with allow_zero).
-void require_positive(const std::string& option, double value, bool allow_zero = false);
+using bendlab::require_positive;  // core/finite_check.hpp
 /// Lower-case extension of path, with the dot (".vtp").
 std::string extension_of(const std::filesystem::path& path);
 /// Throws unless the extension of path is one of `allowed`.

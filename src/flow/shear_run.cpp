@@ -9,6 +9,7 @@
 #include "bendlab/bending/method_registry.hpp"
 #include "bendlab/capsule/run_tolerances.hpp"
 #include "bendlab/capsule/shear_units.hpp"
+#include "bendlab/core/finite_check.hpp"
 #include "bendlab/elasticity/elastic_law.hpp"
 #include "bendlab/flow/bim/bim_capsule_solver.hpp"
 #include "bendlab/flow/lbm/lbm_capsule_solver.hpp"
@@ -22,11 +23,6 @@ namespace bendlab {
 namespace fs = std::filesystem;
 
 namespace {
-
-void require_positive(const std::string& option, double value, bool allow_zero = false) {
-  if (!std::isfinite(value) || value < 0 || (!allow_zero && value == 0))
-    throw Error(fmt::format("{} must be a finite number {} 0, got {}", option, allow_zero ? ">=" : ">", value));
-}
 
 std::string method_list() {
   std::string s;

@@ -5,6 +5,8 @@
 // with a diagnosis instead of flowing on into later stages (where it surfaced as unrelated
 // messages such as "the volume gradient vanishes").
 #include <Eigen/Dense>
+#include <fmt/format.h>
+
 #include <cmath>
 #include <string>
 
@@ -45,6 +47,13 @@ void require_finite_rows(const Eigen::DenseBase<Derived>& a, const std::string& 
     values += std::to_string(static_cast<double>(a(i, j)));
   }
   throw NonFiniteError(what + " is not finite at vertex " + std::to_string(i) + " (" + values + ")", i);
+}
+
+/// Throws Error "<option> must be a finite number > 0, got <value>" (">= 0" with allow_zero) unless
+/// value is finite and positive (or zero where allowed): the check of an input option or argument.
+inline void require_positive(const std::string& option, double value, bool allow_zero = false) {
+  if (std::isfinite(value) && value >= 0 && (allow_zero || value > 0)) return;
+  throw Error(fmt::format("{} must be a finite number {} 0, got {}", option, allow_zero ? ">=" : ">", value));
 }
 
 }  // namespace bendlab
