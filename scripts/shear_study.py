@@ -1,9 +1,10 @@
 #!/usr/bin/python3
 """The capsule-in-shear-flow study of the paper's section 4, regenerated from `bendlab shear` runs.
 
-    /usr/bin/python3 scripts/shear_study.py [--jobs N] [--t-end T] [--only a|b|c] [--bendlab PATH]
+    /usr/bin/python3 scripts/shear_study.py [--jobs N] [--t-end T] [--only a|b|c|e] [--bendlab PATH]
                                             [--work DIR] [--doc FILE] [--triangles LIST]
-                                            [--triangles-a N] [--progress-every S]
+                                            [--triangles-a N] [--triangles-e N] [--progress-every S]
+                                            [--list]
 
 Quick check of the whole chain (a few minutes): --t-end 0.2 --triangles 320 --triangles-a 320
 --work /tmp/shear_preview --doc /tmp/shear_preview/shear.md. The full study (the defaults) is
@@ -18,6 +19,26 @@ Writes docs/results/shear.md and the PNGs it shows (docs/results/shear/):
       and 14);
   (c) the average gamma dt over gamma t in [5, 10] (table 4) beside the paper's values, and the
       wall time of every run.
+  (e) only with --only e: the paper's resolution, 5120 triangles, every run with the stiff-stable
+      Runge-Kutta-Chebyshev integrator (`--integrator rkc --rtol 1e-7 --atol 1e-6`; Cash-Karp is
+      too slow there, docs/results/stiff_stepping.md): figure 12 (no bending, the five G), figure 14
+      (every registered method at both (G, kB_hat) pairs), table 4 (the paper's Cash-Karp mean
+      gamma dt beside RKC's mean step, BIM evaluations and stages), figure 16 (C and S at G = 0.05,
+      kB_hat = 0.0375), figure 17 (A and C at kB_hat = 2/15, G = 0.05 and 0.2) and the study's wall
+      time. 5 + 2 x (number of methods) + 4 runs (25 with A, B, C, D, E, ED, S, J). The paper gives
+      the literature values of figures 16 and 17 only as plots, so they are not drawn.
+      The section sits between markers at the end of --doc: --only e replaces it (or appends it)
+      and leaves the rest of the document as it is; a run of parts (a)-(c) keeps it. Run it in the
+      background, one thread per run (roughly half a day on 2 cores, estimated from the one
+      measured 5120 run of Method C, 1908 s with 2 threads; Methods A and S cost more):
+          OMP_NUM_THREADS=1 nohup /usr/bin/python3 scripts/shear_study.py --only e --jobs 2 \
+              > results/shear_study_e.log 2>&1 &
+      Quick check of the chain (about a minute on one core): --only e --triangles-e 320 --t-end 0.2
+      --jobs 1 --work /tmp/shear_e --doc /tmp/shear_e/shear.md.
+
+--list prints the runs of the chosen parts (or of --add-methods) with the command line of each
+and whether it is done, resumes from a checkpoint or is still to run, and runs nothing:
+    /usr/bin/python3 scripts/shear_study.py --only e --list
 
 Every run is one `bendlab shear ... --no-plot` process whose output folder lies under --work
 (default results/shear_study). A run whose summary.json exists and matches the arguments is not
@@ -30,7 +51,7 @@ and writes them into a section of their own at the end of the existing --doc, ke
     /usr/bin/python3 scripts/shear_study.py --add-methods S --triangles 1280 --jobs 1
 
 --only a|b|c runs only the runs of that part; the other parts appear in the document when all
-their runs are already in the work folder. --t-end below 10 gives a quick preview: the steady
+their runs are already in the work folder. Part (e) runs only with --only e. --t-end below 10 gives a quick preview: the steady
 values and the average step size are then taken over the last half of each run (as
 `bendlab shear` does) and the document says so.
 """
@@ -61,6 +82,15 @@ ROOT = Path(__file__).resolve().parent.parent
 METHODS = []  # the bending methods, from `bendlab methods --json` (set in main)
 G_SWEEP = [0.0125, 0.025, 0.05, 0.1, 0.2]
 PAIRS = [(0.05, 0.0375), (0.2, 0.15)]
+
+# Part (e), the paper's resolution: every run with the stiff-stable Runge-Kutta-Chebyshev
+# integrator (docs/results/stiff_stepping.md) at the tolerances of the paper's Cash-Karp runs.
+E_INTEGRATOR = "rkc"
+RTOL, ATOL = "1e-7", "1e-6"
+FIG16_METHODS = ["C", "S"]  # figure 16: G = 0.05, kB_hat = 0.0375 (runs of figure 14)
+FIG17_KB = 2.0 / 15.0  # figure 17: Methods A and C at kB_hat = 2/15, G = 0.05 and 0.2
+FIG17_G = [0.05, 0.2]
+FIG17_METHODS = ["A", "C"]
 
 # Paper, table 4: average gamma dt over gamma t in [5, 10] chosen by the Cash-Karp stepper
 # (rtol 1e-7, atol 1e-6 R), BIM, MT1 meshes. Keys: (G, kB_hat) -> triangles -> method
@@ -117,6 +147,13 @@ def fmt_g(x):
     return f"{x:g}"
 
 
+def fmt_arg(x):
+    """A number for the command line: as fmt_g where that reads back as the same double, else all
+    the digits (2/15 is 0.13333333333333333, not 0.133333), so that summary.json matches the run."""
+    x = float(x)
+    return fmt_g(x) if float(fmt_g(x)) == x else repr(x)
+
+
 @dataclass(frozen=True)
 class Run:
     method: str  # "none" or a bending method
@@ -124,6 +161,7 @@ class Run:
     G: float
     kappa_b: float
     t_end: float
+    integrator: str = "cash-karp"  # `bendlab shear --integrator`; the paper's Cash-Karp by default
 
     @property
     def mesh(self):
@@ -131,17 +169,23 @@ class Run:
 
     @property
     def name(self):
+        # Cash-Karp runs keep the names they always had (their work folders stay valid).
         return (f"{self.method}_mt1-{self.triangles}_G{fmt_g(self.G)}_kb{fmt_g(self.kappa_b)}"
-                f"_t{fmt_g(self.t_end)}")
+                f"_t{fmt_g(self.t_end)}" + ("" if self.integrator == "cash-karp" else f"_{self.integrator}"))
 
     def label(self):
         return (f"method {self.method:>4}, {self.triangles:4d} triangles, G = {fmt_g(self.G)}, "
-                f"kB_hat = {fmt_g(self.kappa_b)}")
+                f"kB_hat = {fmt_g(self.kappa_b)}" + ("" if self.integrator == "cash-karp" else f", {self.integrator}"))
 
     def arguments(self, out):
-        return ["shear", "--method", self.method, "--mesh", self.mesh, "--G", fmt_g(self.G),
-                "--kappa-b-hat", fmt_g(self.kappa_b), "--t-end", fmt_g(self.t_end), "--out", str(out),
+        args = ["shear", "--method", self.method, "--mesh", self.mesh, "--G", fmt_arg(self.G),
+                "--kappa-b-hat", fmt_arg(self.kappa_b), "--t-end", fmt_arg(self.t_end), "--out", str(out),
                 "--no-plot"]
+        if self.integrator != "cash-karp":
+            # The tolerances of the paper's Cash-Karp runs (which are bendlab shear's defaults),
+            # spelled out so that the command line says what was run.
+            args += ["--integrator", self.integrator, "--rtol", RTOL, "--atol", ATOL]
+        return args
 
 
 @dataclass
@@ -164,9 +208,13 @@ def close(a, b):
 def summary_matches(summary, run):
     """Whether a summary.json was written by a run with the arguments of `run`."""
     try:
-        return (summary.get("method") == run.method and summary.get("mesh") == run.mesh
-                and close(summary.get("G"), run.G) and close(summary.get("kappa_b_hat"), run.kappa_b)
-                and close(summary.get("t_end"), run.t_end))
+        ok = (summary.get("method") == run.method and summary.get("mesh") == run.mesh
+              and close(summary.get("G"), run.G) and close(summary.get("kappa_b_hat"), run.kappa_b)
+              and close(summary.get("t_end"), run.t_end)
+              and summary.get("integrator", "cash-karp") == run.integrator)
+        if ok and run.integrator != "cash-karp":
+            ok = close(summary.get("rtol"), float(RTOL)) and close(summary.get("atol"), float(ATOL))
+        return ok
     except (TypeError, ValueError):
         return False
 
@@ -208,7 +256,8 @@ def checkpoint_matches(run_dir, run):
     except (OSError, ValueError, KeyError, TypeError):
         return False
     return (args.get("method") == run.method and args.get("mesh") == run.mesh
-            and close(args.get("G"), run.G) and close(args.get("kappa_b_hat"), run.kappa_b))
+            and close(args.get("G"), run.G) and close(args.get("kappa_b_hat"), run.kappa_b)
+            and args.get("integrator", "cash-karp") == run.integrator)
 
 
 def execute(run, work, bendlab, counter, total):
@@ -316,9 +365,14 @@ class Counter:
             return self._n
 
 
-def part_runs(part, t_end, triangles, triangles_a):
+def part_runs(part, t_end, triangles, triangles_a, triangles_e=5120):
     if part == "a":
         return [Run("none", triangles_a, G, 0.0, t_end) for G in G_SWEEP]
+    if part == "e":
+        n, it = triangles_e, E_INTEGRATOR
+        return ([Run("none", n, G, 0.0, t_end, it) for G in G_SWEEP]
+                + [Run(m, n, G, kb, t_end, it) for (G, kb) in PAIRS for m in METHODS]
+                + [Run(m, n, G, FIG17_KB, t_end, it) for G in FIG17_G for m in FIG17_METHODS if m in METHODS])
     if part == "b":
         return [Run(m, n, G, kb, t_end) for (G, kb) in PAIRS for n in triangles for m in METHODS]
     if part == "c":
@@ -363,7 +417,7 @@ def fit_slope(G, D):
     return float(np.dot(G, D) / np.dot(G, G))
 
 
-def section_a(results, runs, fig_dir, rel, t_end):
+def section_a(results, runs, fig_dir, rel, t_end, suffix=""):
     lines = ["## (a) No bending: deformation against shear rate (figure 12)", ""]
     n = runs[0].triangles
     ok = [results[r] for r in runs if results[r].ok]
@@ -385,7 +439,7 @@ def section_a(results, runs, fig_dir, rel, t_end):
     ax.legend()
     ax.set_title(f"no bending, {n} triangles (cf. figure 12a)")
     fig.tight_layout()
-    fig.savefig(fig_dir / "fig12a_D_time.png", dpi=110)
+    fig.savefig(fig_dir / f"fig12a_D_time{suffix}.png", dpi=110)
     plt.close(fig)
 
     G = np.array([r.run.G for r in ok])
@@ -416,11 +470,11 @@ def section_a(results, runs, fig_dir, rel, t_end):
     ax.legend(fontsize=8)
     ax.set_title(f"steady deformation, no bending (cf. figure 12b)")
     fig.tight_layout()
-    fig.savefig(fig_dir / "fig12b_D_steady.png", dpi=110)
+    fig.savefig(fig_dir / f"fig12b_D_steady{suffix}.png", dpi=110)
     plt.close(fig)
 
-    lines += [f"![D against gamma t]({rel}/fig12a_D_time.png)", "",
-              f"![steady D against G]({rel}/fig12b_D_steady.png)", ""]
+    lines += [f"![D against gamma t]({rel}/fig12a_D_time{suffix}.png)", "",
+              f"![steady D against G]({rel}/fig12b_D_steady{suffix}.png)", ""]
     lines += [f"Steady values (time average over gamma t in {steady_label(t_end)}, weighted by the step "
               "size), beside the small-deformation result D = 25/4 G:", "",
               "| G | Ca = 3 G | D_steady | theta_steady / pi | 25/4 G | D_steady / (25/4 G) | mean gamma dt | steps | wall s |",
@@ -461,7 +515,7 @@ def section_a(results, runs, fig_dir, rel, t_end):
     return lines
 
 
-def section_b(results, runs, fig_dir, rel, t_end, none_results, suffix=""):
+def section_b(results, runs, fig_dir, rel, t_end, none_results, suffix="", integrator="cash-karp"):
     lines = ["## (b) All bending methods: deformation against time (figures 13 and 14)", ""]
     lines.append("All methods on MT1 meshes, gamma t from 0 to " + fmt_g(t_end) + ". The grey dashed "
                  "curve is the capsule without bending (kB_hat = 0) at the same G and resolution, when "
@@ -480,7 +534,7 @@ def section_b(results, runs, fig_dir, rel, t_end, none_results, suffix=""):
             if ref is not None and ref.ok and ref.series:
                 curves.append(("no bending", "none", ref.series))
             for m in METHODS:
-                r = results.get(Run(m, n, G, kb, t_end))
+                r = results.get(Run(m, n, G, kb, t_end, integrator))
                 if r is not None and r.ok and r.series:
                     curves.append((m, m, r.series))
             for label, key, s in curves:
@@ -516,7 +570,7 @@ def section_b(results, runs, fig_dir, rel, t_end, none_results, suffix=""):
         for m in ["none"] + METHODS:
             cells, ds = [], []
             for n in triangles:
-                r = none_results.get((n, G)) if m == "none" else results.get(Run(m, n, G, kb, t_end))
+                r = none_results.get((n, G)) if m == "none" else results.get(Run(m, n, G, kb, t_end, integrator))
                 if r is None:
                     cells.append("")
                     ds.append(None)
@@ -533,7 +587,7 @@ def section_b(results, runs, fig_dir, rel, t_end, none_results, suffix=""):
                 a, b = ds[0], ds[-1]
                 row += " | " + (f"{100 * (a - b) / b:+.1f} %" if a is not None and b else "")
             last = (none_results.get((triangles[-1], G)) if m == "none"
-                    else results.get(Run(m, triangles[-1], G, kb, t_end)))
+                    else results.get(Run(m, triangles[-1], G, kb, t_end, integrator)))
             th = last.summary["theta_steady"] if last is not None and last.ok else None
             row += " | " + (num(th / math.pi) if th is not None else "") + " |"
             lines.append(row)
@@ -603,6 +657,305 @@ def section_c(results, runs, t_end):
     return lines
 
 
+def demote(lines, title):
+    """Lines of a part's section as a subsection of part (e): '## ...' becomes '### title', deeper
+    headings one level deeper."""
+    out = []
+    for l in lines:
+        if l.startswith("## "):
+            out.append("### " + title)
+        elif l.startswith("###"):
+            out.append("#" + l)
+        else:
+            out.append(l)
+    return out
+
+
+def stat(summary, key):
+    v = (summary.get("integrator_stats") or {}).get(key)
+    return v if isinstance(v, (int, float)) else None
+
+
+def paper_dt(G, kb, n, method):
+    text = PAPER_TABLE4.get((G, kb), {}).get(n, {}).get(method)
+    return (text, float(text)) if text is not None else (None, None)
+
+
+def curve_plot(ax, results, keys, t_end, title):
+    """D against gamma t of the runs `keys` (label -> Run) on `ax`."""
+    for label, (style, run) in keys.items():
+        r = results.get(run)
+        if r is not None and r.ok and r.series:
+            ax.plot(r.series["gamma_t"], r.series["D"], label=label, **METHOD_STYLE.get(style, {}))
+    ax.set_xlabel(r"$\dot\gamma t$")
+    ax.set_ylabel("D")
+    ax.set_xlim(0, t_end)
+    ax.set_ylim(bottom=0)
+    ax.grid(alpha=0.3)
+    ax.legend(loc="lower right", fontsize=8)
+    ax.set_title(title, fontsize=10)
+
+
+def steady_cell(r, key="D_steady", scale=1.0):
+    if r is None:
+        return "not run"
+    if not r.ok:
+        return "failed"
+    v = r.summary.get(key)
+    return num(v / scale if v is not None else None)
+
+
+def section_e(results, runs, fig_dir, rel, t_end, n, meta):
+    """Part (e): figures 12, 14, 16, 17 and table 4 at n triangles (the paper's 5120) with the
+    Runge-Kutta-Chebyshev integrator. `meta` holds the invocation's command, commit and wall time."""
+    it = E_INTEGRATOR
+    suffix = f"_{n}_{it}"
+    ok = [results[r] for r in runs if r in results and results[r].ok]
+    failed = [r for r in runs if r in results and not results[r].ok]
+    missing = [r for r in runs if r not in results]
+    run_wall = sum(r.summary["wall_seconds"] for r in ok if math.isfinite(r.summary["wall_seconds"]))
+    evals = sum(int(r.summary.get("velocity_evaluations") or 0) for r in ok)
+    cached = sum(1 for r in ok if r.cached)
+    lines = [E_BEGIN, "",
+             f"## (e) {n} triangles with the Runge-Kutta-Chebyshev integrator (figures 12, 14, 16, 17; table 4)",
+             "", "Generated by", "", f"    {meta['command']}", "",
+             f"- source commit: {meta['commit']}" if meta.get("commit") else None,
+             f"- runs: {len(runs)} ({len(ok)} finished, {cached} of them taken from the work folder"
+             + (f", {len(failed)} failed" if failed else "") + (f", {len(missing)} not run" if missing else "")
+             + f"), {meta['jobs']} in parallel on {meta['cores']} cores",
+             f"- **wall time of the {n}-triangle study: {run_wall:.0f} s ({run_wall / 3600:.2f} h) of run time "
+             f"together** (the sum of the runs' timing.json `wall_seconds`, which add up the parts of a "
+             f"resumed run), {evals} BIM evaluations in all; this invocation took {meta['wall']:.0f} s "
+             f"({meta['wall'] / 3600:.2f} h) of wall time"
+             + (" (runs taken from the work folder cost it nothing)" if cached else ""),
+             f"- gamma t from 0 to **{fmt_g(t_end)}** in every run"
+             + ("" if t_end >= 10 else " (a preview: the paper runs to 10)"),
+             "",
+             f"Every run is `bendlab shear --method M --mesh mt1:{n} --G G --kappa-b-hat KB --t-end T --no-plot "
+             f"--integrator {it} --rtol {RTOL} --atol {ATOL}`: the boundary integral method as in parts "
+             "(a)-(c), but stepped by the second-order Runge-Kutta-Chebyshev method, whose stages grow with "
+             "the stiffness bending adds so that the step is set by accuracy, not by stability "
+             "(docs/results/stiff_stepping.md: at 5120 triangles it agrees with Cash-Karp to 5e-6 in D at "
+             "gamma t = 2 with about 18x fewer BIM evaluations). The tolerances are those of the paper's "
+             f"Cash-Karp runs. Steady values are time averages over gamma t in {steady_label(t_end)}.",
+             ""]
+    lines = [l for l in lines if l is not None]
+    if n != 5120:
+        lines += [f"**Preview at {n} triangles** (--triangles-e {n}): the paper's figures and table 4 "
+                  "below are at 5120 triangles; the paper's values quoted are those of this resolution "
+                  "where table 4 has them.", ""]
+
+    # Figure 12: no bending, five G.
+    runs_a = [r for r in runs if r.method == "none"]
+    if runs_a and all(r in results for r in runs_a):
+        lines += demote(section_a(results, runs_a, fig_dir, rel, t_end, suffix),
+                        f"(e.1) No bending: deformation against shear rate (figure 12), {n} triangles")
+
+    # Figure 14: every method at the two cases of the paper.
+    none_results = {(n, G): results[r] for r in runs_a if r in results for (G, kb) in PAIRS if close(r.G, G)}
+    runs_b = [r for r in runs if r.method != "none" and (r.G, r.kappa_b) in PAIRS]
+    body = section_b(results, runs_b, fig_dir, rel, t_end, none_results, f"_{it}", it)
+    lines += demote(body, f"(e.2) All bending methods: deformation against time (figure 14), {n} triangles")
+
+    # Table 4: the paper's Cash-Karp step beside RKC's step and evaluations.
+    lines += [f"### (e.3) Average time step (table 4) and BIM evaluations, {n} triangles", "",
+              f"Paper: mean gamma dt of its Cash-Karp runs over gamma t in [5, 10] (table 4, BIM, MT1, "
+              f"{n} triangles). RKC: `mean_gamma_dt` of summary.json (accepted steps ending in gamma t in "
+              f"{steady_label(t_end)}), the BIM evaluations of the whole run (`velocity_evaluations`: "
+              "stages, power iterations for the spectral radius, the re-evaluation after the volume "
+              "rescale) and the mean number of stages per step. The last column is what Cash-Karp would "
+              f"need at the paper's steady step over the whole run, 6 x {fmt_g(t_end)} / gamma dt (six "
+              "evaluations per step, rejected steps and the start-up not counted): an estimate for scale, "
+              "not a measurement. The paper has no column for ED, S or J.", ""]
+    if t_end < 10:
+        lines += [f"Preview run: the RKC window is gamma t in {steady_label(t_end)}, not [5, 10], so the "
+                  "ratios are not those of the full study.", ""]
+    for (G, kb) in PAIRS:
+        lines += [f"#### G = {fmt_g(G)}, kB_hat = {fmt_g(kb)} (paper: table 4{'a' if G < 0.1 else 'b'})", "",
+                  "| method | paper: Cash-Karp gamma dt | RKC gamma dt | RKC / paper | RKC evaluations | "
+                  "accepted / rejected steps | mean stages | Cash-Karp evaluations at the paper's step (estimate) | wall s |",
+                  "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+        for m in ["none"] + METHODS:
+            r = results.get(Run(m, n, G, 0.0 if m == "none" else kb, t_end, it))
+            if r is None:
+                continue
+            p_text, p = paper_dt(G, kb, n, m)
+            name = "no bending" if m == "none" else m
+            if not r.ok:
+                lines.append(f"| {name} | {p_text or '-'} | failed | | | | | | |")
+                continue
+            s = r.summary
+            v = s.get("mean_gamma_dt")
+            stages = stat(s, "mean_stages")
+            lines.append(f"| {name} | {p_text or '-'} | {num(v, 3)} | {f'{v / p:.2g}' if v and p else '-'} | "
+                         f"{s.get('velocity_evaluations', '')} | {s['steps']} / {s.get('rejected_steps', '')} | "
+                         f"{num(stages, 3)} | {f'{6 * t_end / p:.2g}' if p else '-'} | {s['wall_seconds']:.0f} |")
+        lines.append("")
+
+    # Figure 16: Methods C and S at G = 0.05, kB_hat = 0.0375.
+    G16, kb16 = PAIRS[0]
+    m16 = [m for m in FIG16_METHODS if m in METHODS]
+    keys = {f"Method {m}": (m, Run(m, n, G16, kb16, t_end, it)) for m in m16}
+    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    curve_plot(ax, results, keys, t_end, f"G = {fmt_g(G16)}, kB_hat = {fmt_g(kb16)}, {n} triangles (cf. figure 16)")
+    fig.tight_layout()
+    name16 = f"fig16_C_S{suffix}.png"
+    fig.savefig(fig_dir / name16, dpi=110)
+    plt.close(fig)
+    rc = results.get(Run("C", n, G16, kb16, t_end, it))
+    rs = results.get(Run("S", n, G16, kb16, t_end, it))
+    dc = rc.summary["D_steady"] if rc is not None and rc.ok else None
+    ds = rs.summary["D_steady"] if rs is not None and rs.ok else None
+    lines += [f"### (e.4) Methods C and S against the literature (figure 16), {n} triangles", "",
+              f"![D against gamma t, C and S]({rel}/{name16})", "",
+              "| method | D_steady | theta_steady / pi |", "| --- | --- | --- |",
+              f"| C | {steady_cell(rc)} | {steady_cell(rc, 'theta_steady', math.pi)} |",
+              f"| S | {steady_cell(rs)} | {steady_cell(rs, 'theta_steady', math.pi)} |", "",
+              (f"S against C: {100 * (ds - dc) / dc:+.2f} % in D_steady." if dc and ds else
+               "S against C: not available (a run is missing or failed)."), "",
+              "The paper's figure 16 compares C and S with the recent literature at the same G and kB_hat "
+              "(Pozrikidis 2001 with a Hookean law, Huang et al. with Zarda's bending model, and others "
+              "named only in the plot). The literature values appear in the paper only as curves in the "
+              "plot: neither its text nor the specification gives them as numbers, so they are not drawn "
+              "here. The text says only that they scatter by up to about 20 %.", ""]
+
+    # Figure 17: Methods A and C at kB_hat = 2/15.
+    m17 = [m for m in FIG17_METHODS if m in METHODS]
+    fig, axes = plt.subplots(1, len(FIG17_G), figsize=(10.5, 4.2))
+    for ax, G in zip(np.atleast_1d(axes), FIG17_G):
+        keys = {f"Method {m}": (m, Run(m, n, G, FIG17_KB, t_end, it)) for m in m17}
+        curve_plot(ax, results, keys, t_end, f"G = {fmt_g(G)}, kB_hat = 2/15, {n} triangles")
+    fig.suptitle("cf. figure 17", fontsize=10)
+    fig.tight_layout()
+    name17 = f"fig17_A_C{suffix}.png"
+    fig.savefig(fig_dir / name17, dpi=110)
+    plt.close(fig)
+    lines += [f"### (e.5) Methods A and C at kB_hat = 2/15 (figure 17), {n} triangles", "",
+              f"![D against gamma t, A and C, kB_hat = 2/15]({rel}/{name17})", "",
+              "| G | D_steady, A | D_steady, C | A / C - 1 | theta_steady / pi, A | theta_steady / pi, C |",
+              "| --- | --- | --- | --- | --- | --- |"]
+    for G in FIG17_G:
+        ra = results.get(Run("A", n, G, FIG17_KB, t_end, it))
+        rc = results.get(Run("C", n, G, FIG17_KB, t_end, it))
+        da = ra.summary["D_steady"] if ra is not None and ra.ok else None
+        dc = rc.summary["D_steady"] if rc is not None and rc.ok else None
+        lines.append(f"| {fmt_g(G)} | {steady_cell(ra)} | {steady_cell(rc)} | "
+                     f"{f'{100 * (da - dc) / dc:+.1f} %' if da and dc else ''} | "
+                     f"{steady_cell(ra, 'theta_steady', math.pi)} | {steady_cell(rc, 'theta_steady', math.pi)} |")
+    lines += ["", "The paper's figure 17 draws Tsubota 2014 (BIM, 4604 flat triangles; his model KN is Method A, "
+              "model H is Method C) beside its A and C. Tsubota's values appear in the paper only as curves "
+              "in the plot, not as numbers in its text or in the specification, so they are not drawn here. "
+              "The paper says its A and C agree with his extremely well.", ""]
+    if t_end < 10:
+        lines += [f"Preview run (gamma t up to {fmt_g(t_end)}): the curves show only the start-up.", ""]
+
+    # Run times.
+    lines += [f"### (e.6) Run times, {n} triangles", "",
+              "Each `bendlab shear` run: wall time (timing.json; the machine shared with the other runs of "
+              "the study), accepted and rejected steps, BIM evaluations, mean stages per step, the largest "
+              "spectral radius estimate (x1.1) and the relative volume change at the end.", "",
+              "| G | kB_hat | method | wall s | steps | rejected | BIM evaluations | mean stages | "
+              "spectral radius max | volume change |",
+              "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+    for run in runs:
+        r = results.get(run)
+        name = "no bending" if run.method == "none" else run.method
+        kb = "2/15" if close(run.kappa_b, FIG17_KB) else fmt_g(run.kappa_b)
+        if r is None or not r.ok:
+            lines.append(f"| {fmt_g(run.G)} | {kb} | {name} | {'not run' if r is None else 'failed: ' + str(r.error)} "
+                         "| | | | | | |")
+            continue
+        s = r.summary
+        dv = (s["final_volume"] - s["initial_volume"]) / s["initial_volume"]
+        lines.append(f"| {fmt_g(run.G)} | {kb} | {name} | {s['wall_seconds']:.0f} | {s['steps']} | "
+                     f"{s.get('rejected_steps', '')} | {s.get('velocity_evaluations', '')} | "
+                     f"{num(stat(s, 'mean_stages'), 3)} | {num(stat(s, 'spectral_radius_max'), 3)} | {dv:.1e} |")
+    lines += [f"| | | **all {len(runs)} runs** | **{run_wall:.0f}** | | | **{evals}** | | | |", "", E_END, ""]
+    return lines
+
+
+E_BEGIN = "<!-- rkc-study:begin -->"
+E_END = "<!-- rkc-study:end -->"
+
+
+def replace_block(text, begin, end, block):
+    """`text` with its block between the markers begin and end replaced by `block` (which starts
+    with begin and ends with end), or `block` appended where `text` has no such block."""
+    block = block.strip("\n")
+    if begin in text and end in text:
+        head, _, rest = text.partition(begin)
+        tail = rest.partition(end)[2].strip("\n")
+        return head.rstrip("\n") + "\n\n" + block + "\n" + ("\n" + tail + "\n" if tail else "")
+    return text.rstrip("\n") + "\n\n" + block + "\n"
+
+
+def old_block(path, begin, end):
+    """The marked block of an existing document, or None."""
+    try:
+        text = path.read_text()
+    except OSError:
+        return None
+    if begin in text and end in text:
+        return begin + text.partition(begin)[2].partition(end)[0] + end
+    return None
+
+
+def added_runs(added, t_end, triangles):
+    """The runs of --add-methods: the added methods and the no-bending references of (b) and (c)."""
+    return ([Run(m, n, G, kb, t_end) for (G, kb) in PAIRS for n in triangles for m in added]
+            + [Run("none", n, G, 0.0, t_end) for (G, kb) in PAIRS for n in triangles])
+
+
+def source_commit():
+    """The short hash of HEAD, marked when tracked files differ from it ('' outside git)."""
+    try:
+        commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
+                                text=True).stdout.strip()
+        if commit and subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], cwd=ROOT,
+                                     capture_output=True, text=True).stdout.strip():
+            commit += " with uncommitted changes"
+        return commit
+    except OSError:
+        return ""
+
+
+def run_state(run, work):
+    """('done', summary) for a finished run, ('resume', checkpoint) for one that continues from its
+    checkpoint, ('run', None) for one still to start, as execute() would treat it."""
+    out = work / run.name
+    summary = read_summary(out / "summary.json")
+    if summary is not None and summary_matches(summary, run):
+        return "done", summary
+    if summary is None and out.is_dir() and checkpoint_matches(out, run):
+        try:
+            return "resume", json.loads((out / "checkpoint.json").read_text())
+        except (OSError, ValueError):
+            pass
+    return "run", None
+
+
+def list_runs(runs, work, bendlab, what):
+    """--list: the runs, their state and the command each is (or was) run with; runs nothing."""
+    say(f"{what}: {len(runs)} runs, in the order they are started; work folder {work}")
+    counts = {"done": 0, "resume": 0, "run": 0}
+    for run in runs:
+        state, info = run_state(run, work)
+        counts[state] += 1
+        cmd = [str(bendlab)] + run.arguments(work / run.name)
+        if state == "done":
+            note = (f"done: D_steady {num(info.get('D_steady'))}, {info.get('velocity_evaluations', '?')} "
+                    f"evaluations, {info['wall_seconds']:.0f} s")
+        elif state == "resume":
+            cmd.append("--resume")
+            note = (f"resumes at gamma t = {num(info.get('time'), 3)} of {fmt_g(run.t_end)} "
+                    f"({float(info.get('wall_seconds') or 0):.0f} s so far)")
+        else:
+            note = "to run"
+        say(f"  {run.label()}: {note}\n      $ {shlex.join(cmd)}")
+    say(f"{counts['done']} done, {counts['resume']} to resume from a checkpoint, {counts['run']} to run")
+    return 0
+
+
 # ----------------------------------------------------------------------------- main
 
 def main():
@@ -611,7 +964,9 @@ def main():
     ap.add_argument("--jobs", type=int, default=2, help="runs in parallel (default 2)")
     ap.add_argument("--t-end", type=float, default=10.0,
                     help="end of every run in gamma t (default 10; smaller for a quick preview)")
-    ap.add_argument("--only", choices=["a", "b", "c"], help="run only the runs of this part")
+    ap.add_argument("--only", choices=["a", "b", "c", "e"],
+                    help="run only the runs of this part; e (5120 triangles, RKC) is run only when asked "
+                         "for and writes its own section at the end of --doc, keeping the rest")
     ap.add_argument("--bendlab", default="build/release/bendlab", help="the bendlab binary")
     ap.add_argument("--work", default="results/shear_study", help="folder of the runs (the cache)")
     ap.add_argument("--doc", default="docs/results/shear.md",
@@ -621,6 +976,11 @@ def main():
     ap.add_argument("--progress-every", type=float, default=60,
                     help="seconds between progress lines of the running runs (default 60)")
     ap.add_argument("--triangles-a", type=int, default=1280, help="resolution of part (a) (default 1280)")
+    ap.add_argument("--triangles-e", type=int, default=5120,
+                    help="resolution of part (e) (default 5120, the paper's; smaller for a quick preview)")
+    ap.add_argument("--list", action="store_true",
+                    help="print the runs the chosen parts need, with their command lines and whether each "
+                         "is done, can resume from a checkpoint or is still to run; runs nothing")
     ap.add_argument("--add-methods", default="",
                     help="comma-separated bending methods to add to an existing --doc: runs only these "
                          "methods (and the no-bending references) of parts (b) and (c) at --triangles and "
@@ -649,26 +1009,43 @@ def main():
     work = Path(args.work).resolve()
     doc = Path(args.doc).resolve()
     fig_dir = doc.with_suffix("")
-    work.mkdir(parents=True, exist_ok=True)
-    fig_dir.mkdir(parents=True, exist_ok=True)
+    if not args.list:
+        work.mkdir(parents=True, exist_ok=True)
+        fig_dir.mkdir(parents=True, exist_ok=True)
     if args.add_methods:
         added = [m for m in args.add_methods.split(",") if m.strip()]
         unknown = [m for m in added if m not in METHODS]
         if unknown:
             ap.error(f"--add-methods: unknown method(s) {', '.join(unknown)} (known: {', '.join(METHODS)})")
+        if args.list:
+            return list_runs(added_runs(added, args.t_end, triangles), work, bendlab,
+                             f"--add-methods {','.join(added)}")
         if not doc.is_file():
             ap.error(f"--add-methods: no document {doc} to add to")
         return add_methods(added, args, command, bendlab, work, doc, fig_dir, triangles)
 
+    if args.triangles_e < 20:
+        ap.error("--triangles-e must be an MT1 size (20 * 4^k, e.g. 320, 1280, 5120)")
     parts = [args.only] if args.only else ["a", "b", "c"]
-    runs_of = {p: part_runs(p, args.t_end, triangles, args.triangles_a) for p in "abc"}
+    runs_of = {p: part_runs(p, args.t_end, triangles, args.triangles_a, args.triangles_e) for p in "abce"}
     todo = list(dict.fromkeys(r for p in parts for r in runs_of[p]))
     # Long runs first, so that the parallel runs end close together: bending methods at the
-    # finest mesh, then by the paper's step size.
+    # finest mesh, then by the paper's step size. RKC's stage count grows with the square root of
+    # the stiffness that sets Cash-Karp's step; Method S costs about twice C per evaluation.
     def cost(r):
         dt = float(PAPER_TABLE4.get((r.G, r.kappa_b), {}).get(r.triangles, {}).get(r.method, "0.05"))
+        if r.integrator != "cash-karp":
+            # The paper's Cash-Karp step of the pair with this G (figure 17's kB_hat is not in
+            # table 4); ED, S and J relative to C as measured with Cash-Karp at 1280 triangles.
+            pair = next(((G, kb) for (G, kb) in PAIRS if close(G, r.G)), PAIRS[0])
+            row = PAPER_TABLE4[pair].get(r.triangles) or PAPER_TABLE4[pair][5120]
+            m = r.method if r.method in row else "C"
+            dt = float(row[m]) * {"ED": 4.9, "S": 0.18}.get(r.method, 1.0)
+            return -(r.triangles ** 2) * (2 if r.method == "S" else 1) / math.sqrt(dt)
         return -(r.triangles ** 1.5) * (4 if r.method == "D" else 1) / dt
     todo.sort(key=cost)
+    if args.list:
+        return list_runs(todo, work, bendlab, f"part(s) {', '.join(parts)}")
 
     say(f"shear study: {len(todo)} runs (parts {', '.join(parts)}), t_end {fmt_g(args.t_end)}, "
         f"{args.jobs} in parallel, work folder {work}")
@@ -694,6 +1071,24 @@ def main():
         return 130
     pool.shutdown(wait=True)
     wall = time.monotonic() - start
+
+    commit = source_commit()
+    if parts == ["e"]:
+        load_series(results, work)
+        meta = dict(command=command, commit=commit, wall=wall, jobs=args.jobs,
+                    cores=len(os.sched_getaffinity(0)))
+        rel = os.path.relpath(fig_dir, doc.parent)
+        block = "\n".join(section_e(results, runs_of["e"], fig_dir, rel, args.t_end, args.triangles_e, meta))
+        text = doc.read_text() if doc.is_file() else (
+            "# Capsule in shear flow (paper section 4)\n\nParts (a)-(c) are written by "
+            "scripts/shear_study.py without --only e; this document has only part (e) so far.\n")
+        doc.parent.mkdir(parents=True, exist_ok=True)
+        tmp = doc.with_suffix(".md.tmp")
+        tmp.write_text(replace_block(text, E_BEGIN, E_END, block).replace("\n\n\n", "\n\n"))
+        tmp.replace(doc)
+        failed = [r for r in results.values() if not r.ok]
+        say(f"wrote part (e) of {doc} and its figures in {fig_dir}/ ({wall:.0f} s; {len(failed)} failed runs)")
+        return 1 if failed else 0
 
     # Parts not run now enter the document when all their runs are in the work folder.
     shown = []
@@ -727,15 +1122,6 @@ def main():
                 break
     except OSError:
         pass
-    try:
-        commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
-                                text=True).stdout.strip()
-        if commit and subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], cwd=ROOT,
-                                     capture_output=True, text=True).stdout.strip():
-            commit += " with uncommitted changes"
-    except OSError:
-        commit = ""
-
     lines = ["# Capsule in shear flow (paper section 4)", "",
              "Generated by", "", f"    {command}", "",
              f"- machine: {len(os.sched_getaffinity(0))} cores (nproc){', ' + cpu if cpu else ''}, {platform.system()} "
@@ -766,9 +1152,14 @@ def main():
         if p not in shown:
             lines += [f"## ({p})", "", f"Not shown: part ({p}) was not run with these options "
                       f"(run `--only {p}` or without --only).", ""]
+    text = "\n".join(lines)
+    # Part (e) is written by --only e alone: its section of the earlier document stays.
+    kept = old_block(doc, E_BEGIN, E_END)
+    if kept is not None:
+        text = replace_block(text, E_BEGIN, E_END, kept)
     doc.parent.mkdir(parents=True, exist_ok=True)
     tmp = doc.with_suffix(".md.tmp")
-    tmp.write_text("\n".join(lines).replace("\n\n\n", "\n\n"))
+    tmp.write_text(text.replace("\n\n\n", "\n\n"))
     tmp.replace(doc)
     say(f"wrote {doc} and {fig_dir}/ ({wall:.0f} s; {len(failed)} failed runs)")
     return 1 if failed else 0
@@ -783,8 +1174,7 @@ def add_methods(added, args, command, bendlab, work, doc, fig_dir, triangles):
     document's added-methods section, which replaces an earlier one; the rest of the document is
     kept: its figures and tables come from an invocation whose runs need not be in the work folder."""
     METHODS[:] = added
-    runs = ([Run(m, n, G, kb, args.t_end) for (G, kb) in PAIRS for n in triangles for m in added]
-            + [Run("none", n, G, 0.0, args.t_end) for (G, kb) in PAIRS for n in triangles])
+    runs = added_runs(added, args.t_end, triangles)
     say(f"shear study: adding {', '.join(added)}: {len(runs)} runs, {args.jobs} in parallel, work folder {work}")
     start = time.monotonic()
     counter = Counter()
@@ -798,8 +1188,7 @@ def add_methods(added, args, command, bendlab, work, doc, fig_dir, triangles):
     none_results = {(r.triangles, r.G): res for r, res in results.items() if r.method == "none"}
     rel = os.path.relpath(fig_dir, doc.parent)
     suffix = "_" + "".join(added)
-    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
-                            text=True).stdout.strip()
+    commit = source_commit()
     lines = [ADDED_BEGIN, "", f"## (d) Methods added to the study: {', '.join(added)}", "",
              "Generated by", "", f"    {command}", "",
              f"(source commit {commit}, {wall:.0f} s of wall time). The sections above come from the earlier "
