@@ -29,11 +29,13 @@ Writes docs/results/shear.md and the PNGs it shows (docs/results/shear/):
       the literature values of figures 16 and 17 only as plots, so they are not drawn.
       The section sits between markers at the end of --doc: --only e replaces it (or appends it)
       and leaves the rest of the document as it is; a run of parts (a)-(c) keeps it. Run it in the
-      background, one thread per run (roughly half a day on 2 cores, estimated from the one
-      measured 5120 run of Method C, 1908 s with 2 threads; Methods A and S cost more):
-          OMP_NUM_THREADS=1 nohup /usr/bin/python3 scripts/shear_study.py --only e --jobs 2 \
-              > results/shear_study_e.log 2>&1 &
-      Quick check of the chain (about a minute on one core): --only e --triangles-e 320 --t-end 0.2
+      background, one thread per run. Estimate (not a measured study): about 10 hours of run time,
+      5 or more of wall time with --jobs 2 on the shared 2 cores, from one BIM evaluation at 5120
+      triangles on one thread (0.15 s for C, 0.24 s for S) and the 8260 evaluations of the one
+      measured run (C, G = 0.2); A and S need about twice C's evaluations, D, ED and no bending fewer:
+          mkdir -p results && OMP_NUM_THREADS=1 nohup /usr/bin/python3 scripts/shear_study.py \
+              --only e --jobs 2 > results/shear_study_e.log 2>&1 &
+      Quick check of the chain (under a minute on one core): --only e --triangles-e 320 --t-end 0.2
       --jobs 1 --work /tmp/shear_e --doc /tmp/shear_e/shear.md.
 
 --list prints the runs of the chosen parts (or of --add-methods) with the command line of each
@@ -51,9 +53,9 @@ and writes them into a section of their own at the end of the existing --doc, ke
     /usr/bin/python3 scripts/shear_study.py --add-methods S --triangles 1280 --jobs 1
 
 --only a|b|c runs only the runs of that part; the other parts appear in the document when all
-their runs are already in the work folder. Part (e) runs only with --only e. --t-end below 10 gives a quick preview: the steady
-values and the average step size are then taken over the last half of each run (as
-`bendlab shear` does) and the document says so.
+their runs are already in the work folder. Part (e) runs only with --only e. --t-end below 10
+gives a quick preview: the steady values and the average step size are then taken over the last
+half of each run (as `bendlab shear` does) and the document says so.
 """
 import argparse
 import csv
@@ -1024,7 +1026,7 @@ def main():
             ap.error(f"--add-methods: no document {doc} to add to")
         return add_methods(added, args, command, bendlab, work, doc, fig_dir, triangles)
 
-    if args.triangles_e < 20:
+    if args.triangles_e not in [20 * 4 ** k for k in range(8)]:
         ap.error("--triangles-e must be an MT1 size (20 * 4^k, e.g. 320, 1280, 5120)")
     parts = [args.only] if args.only else ["a", "b", "c"]
     runs_of = {p: part_runs(p, args.t_end, triangles, args.triangles_a, args.triangles_e) for p in "abce"}
