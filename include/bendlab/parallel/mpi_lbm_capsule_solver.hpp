@@ -1,6 +1,6 @@
 #pragma once
-// LbmCapsuleSolver (flow/lbm/lbm_capsule_solver.hpp) over the ranks of an MPI communicator: the
-// fluid is a DistributedLattice (y-slabs), the membrane is whole on every rank. Same options,
+// The IbCapsuleSolver (flow/lbm/ib_capsule_solver.hpp) of LbmCapsuleSolver over the ranks of an MPI
+// communicator: the fluid is a DistributedLattice (y-slabs), the membrane is whole on every rank. Same options,
 // same steps, same reports, same checkpoints (name "lbm", the same solver_state fields and fluid
 // file), so a run may be resumed with another rank count or by the serial solver.
 //
@@ -26,53 +26,32 @@
 #include <memory>
 #include <vector>
 
-#include "bendlab/capsule/capsule_solver.hpp"
-#include "bendlab/flow/lbm/lbm_capsule_solver.hpp"
+#include "bendlab/flow/lbm/ib_capsule_solver.hpp"
 #include "bendlab/parallel/distributed_lattice.hpp"
 
 namespace bendlab::parallel {
 
-class MpiLbmCapsuleSolver final : public CapsuleSolver {
+class MpiLbmCapsuleSolver final : public IbCapsuleSolver {
  public:
-  static constexpr std::int64_t kFluidCheckSteps = LbmCapsuleSolver::kFluidCheckSteps;
-
   /// As LbmCapsuleSolver's constructor (the same errors), on the ranks of `comm` (collective).
   MpiLbmCapsuleSolver(std::shared_ptr<const MembraneModel> membrane, LbmSolverOptions options, MPI_Comm comm);
 
-  std::string name() const override { return "lbm"; }
-  const MembraneModel& membrane() const override { return *membrane_; }
-  const Points& positions() const override { return x_; }
-  double time() const override { return static_cast<double>(fluid_.step_count()) * gamma_; }
-  bool advance(double t_end, const OnStep& on_step) override;
-  SolverCounters counters() const override { return counters_; }
-  SolverState save_state(const std::filesystem::path& folder, const std::string& tag) const override;
-  void restore_state(const Points& positions, double time, const SolverCounters& counters,
-                     const nlohmann::json& fields, const std::filesystem::path& folder,
-                     const std::string& source) override;
-
-  void step();
-
   const DistributedLattice& fluid() const { return fluid_; }
-  const Points& lattice_positions() const { return X_; }
-  std::int64_t sample_steps() const { return sample_steps_; }
 
  private:
-  void check_fluid() const;
+  std::int64_t fluid_step_count() const override { return fluid_.step_count(); }
+  void ib_step(Points& X, const Points& F, Points& U) override;
+  void check_fluid() const override;
+  void write_fluid(const std::filesystem::path& file) const override;
+  std::int64_t read_fluid(const std::filesystem::path& file, std::int64_t step) override;
 
-  std::shared_ptr<const MembraneModel> membrane_;
-  LbmSolverOptions options_;
   DistributedLattice fluid_;
-  double gamma_ = 0, force_scale_ = 0;
-  std::int64_t sample_steps_ = 1;
-  Points X_, x_, F_, U_;
-  // Scratch of step(): kernels, owner rank of each node's kernel (-1: straddles slabs), offsets of
-  // its terms in the reduced buffer.
+  // Scratch of ib_step(): kernels, owner rank of each node's kernel (-1: straddles slabs), offsets
+  // of its terms in the reduced buffer.
   std::vector<lbm::IbStencil> stencils_;
   std::vector<int> owner_;
   std::vector<Eigen::Index> offsets_;
   std::vector<double> terms_, sums_;
-  SolverCounters counters_;
-  std::int64_t last_fluid_check_ = 0;
 };
 
 }  // namespace bendlab::parallel

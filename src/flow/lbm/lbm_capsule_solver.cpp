@@ -1,139 +1,32 @@
 #include "bendlab/flow/lbm/lbm_capsule_solver.hpp"
 
-#include <fmt/format.h>
-
-#include <cmath>
-
 #include "bendlab/flow/lbm/checkpoint.hpp"
 #include "bendlab/flow/lbm/diagnostics.hpp"
-#include "bendlab/geometry/measures.hpp"
 
 namespace bendlab {
 
-namespace {
-const std::shared_ptr<const MembraneModel>& checked(const std::shared_ptr<const MembraneModel>& m,
-                                                    const LbmSolverOptions& o) {
-  if (m == nullptr) throw Error("LBM: no membrane model");
-  if (!(o.radius > 0) || !std::isfinite(o.radius)) throw Error(fmt::format("LBM: radius {} must be positive", o.radius));
-  if (!(o.sample_every > 0) || !std::isfinite(o.sample_every))
-    throw Error(fmt::format("LBM: sample_every {} must be positive", o.sample_every));
-  if (!(o.lattice.shear_rate > 0) || !std::isfinite(o.lattice.shear_rate))
-    throw Error("LBM: the lattice parameters have no shear rate (use lbm::capsule_run_parameters)");
-  return m;
-}
-}  // namespace
-
 LbmCapsuleSolver::LbmCapsuleSolver(std::shared_ptr<const MembraneModel> membrane, LbmSolverOptions options)
-    : membrane_(checked(membrane, options)), options_(options), lattice_(options.lattice.lattice_config()) {
-  gamma_ = lattice_.shear_rate();
-  force_scale_ = lattice_.viscosity() * gamma_ * options_.radius * options_.radius;
-  sample_steps_ = std::max<std::int64_t>(1, std::llround(options_.sample_every / gamma_));
-  x_ = membrane_->reference_positions();
-  x_.rowwise() -= volume_centroid(membrane_->topology(), x_).transpose();
-  X_ = options_.radius * x_;
-  for (Eigen::Index k = 0; k < X_.rows(); ++k) lbm::ib_stencil(lattice_, row(X_, k), options_.kernel);
+    : IbCapsuleSolver(std::move(membrane), std::move(options)), lattice_(this->options().lattice.lattice_config()) {
+  place_capsule(lattice_.shear_rate(), lattice_.viscosity());
   lattice_.initialise_shear_flow();
+}
+
+void LbmCapsuleSolver::ib_step(Points& X, const Points& F, Points& U) {
+  lbm::ib_step(lattice_, X, F, U, options().kernel);
 }
 
 void LbmCapsuleSolver::check_fluid() const {
   if (const auto b = lbm::find_blow_up(lattice_)) throw Error(b->message);
 }
 
-void LbmCapsuleSolver::step() {
-  const std::int64_t n = lattice_.step_count() + 1;  // the step being taken
-  try {
-    membrane_->forces(x_, F_);
-    F_ *= force_scale_;
-    lbm::ib_step(lattice_, X_, F_, U_, options_.kernel);
-  } catch (const Error& e) {
-    throw Error(fmt::format("LBM step {}: {}", n, e.what()));
-  }
-  ++counters_.velocity_evaluations;
-  const double reach = 0.5 * lattice_.nz() - lbm::ib_kernel_half_width(options_.kernel);
-  for (Eigen::Index k = 0; k < X_.rows(); ++k) {
-    if (!std::isfinite(X_(k, 0)) || !std::isfinite(X_(k, 1)) || !std::isfinite(X_(k, 2)))
-      throw Error(fmt::format("LBM blew up at step {}: membrane node {} has a non-finite position", n, k));
-    if (std::abs(X_(k, 2)) > reach)
-      throw Error(fmt::format("LBM step {}: membrane node {} at z = {:.4g} dx is within the kernel's reach of a wall "
-                              "(walls at z = +-{})",
-                              n, k, X_(k, 2), 0.5 * lattice_.nz()));
-  }
-  x_ = X_ / options_.radius;
-  if (n - last_fluid_check_ >= kFluidCheckSteps) {
-    check_fluid();
-    last_fluid_check_ = n;
-  }
-}
+void LbmCapsuleSolver::write_fluid(const std::filesystem::path& file) const { lbm::write_checkpoint(lattice_, file); }
 
-bool LbmCapsuleSolver::advance(double t_end, const OnStep& on_step) {
-  std::int64_t last_report = lattice_.step_count();
-  while (time() < t_end) {
-    step();
-    const std::int64_t n = lattice_.step_count();
-    if (n % sample_steps_ != 0 && time() < t_end) continue;
-    if (!on_step) {
-      last_report = n;
-      continue;
-    }
-    AcceptedStep s;
-    s.time = time();
-    s.dt = static_cast<double>(n - last_report) * gamma_;
-    s.positions = &x_;
-    last_report = n;
-    if (!on_step(s)) return false;
-  }
-  return true;
-}
-
-SolverState LbmCapsuleSolver::save_state(const std::filesystem::path& folder, const std::string& tag) const {
-  check_fluid();  // never checkpoint a broken fluid
-  SolverState s;
-  const std::string fluid = fmt::format("lbm_fluid_{}.bin", tag);
-  lbm::write_checkpoint(lattice_, folder / fluid);
-  s.side_files.push_back(fluid);
-  s.fields = {{"fluid", fluid},
-              {"lattice_step", lattice_.step_count()},
-              {"positions_lattice", std::vector<double>(X_.data(), X_.data() + X_.size())}};
-  return s;
-}
-
-void LbmCapsuleSolver::restore_state(const Points& positions, double time, const SolverCounters& counters,
-                                     const nlohmann::json& fields, const std::filesystem::path& folder,
-                                     const std::string& source) {
-  auto bad = [&](const std::string& what) { return Error(fmt::format("{}: \"solver_state\": {}", source, what)); };
-  if (!fields.is_object()) throw bad("must be an object");
-  if (!fields.contains("fluid") || !fields.at("fluid").is_string()) throw bad("\"fluid\" must name the fluid file");
-  if (!fields.contains("lattice_step") || !fields.at("lattice_step").is_number_integer() ||
-      fields.at("lattice_step").get<std::int64_t>() < 0)
-    throw bad("\"lattice_step\" must be an integer >= 0");
-  const std::int64_t n = fields.at("lattice_step").get<std::int64_t>();
-  if (!fields.contains("positions_lattice") || !fields.at("positions_lattice").is_array() ||
-      fields.at("positions_lattice").size() != static_cast<std::size_t>(X_.size()))
-    throw bad(fmt::format("\"positions_lattice\" must hold {} numbers", X_.size()));
-  Points X(X_.rows(), 3);
-  for (Eigen::Index i = 0; i < X.size(); ++i) {
-    const auto& v = fields.at("positions_lattice")[static_cast<std::size_t>(i)];
-    if (!v.is_number() || !std::isfinite(v.get<double>())) throw bad("\"positions_lattice\" has a non-finite entry");
-    X.data()[i] = v.get<double>();
-  }
-  const double t = static_cast<double>(n) * gamma_;
-  if (std::abs(t - time) > 1e-9 * std::max(1.0, std::abs(time)))
-    throw bad(fmt::format("\"lattice_step\" {} is gamma t = {}, the checkpoint's time is {}", n, t, time));
-  if (positions.rows() != X.rows() || ((X / options_.radius) - positions).cwiseAbs().maxCoeff() > 1e-9)
-    throw bad("\"positions_lattice\" do not match the checkpoint's positions");
+std::int64_t LbmCapsuleSolver::read_fluid(const std::filesystem::path& file, std::int64_t step) {
   lbm::Lattice restored(lattice_.config());
-  try {
-    lbm::read_checkpoint(restored, folder / fields.at("fluid").get<std::string>());
-  } catch (const Error& e) {
-    throw Error(fmt::format("{}: {}", source, e.what()));
-  }
-  if (restored.step_count() != n)
-    throw bad(fmt::format("the fluid file is at step {}, \"lattice_step\" is {}", restored.step_count(), n));
-  lattice_ = std::move(restored);
-  X_ = X;
-  x_ = X_ / options_.radius;
-  counters_ = counters;
-  last_fluid_check_ = n;
+  lbm::read_checkpoint(restored, file);
+  const std::int64_t file_step = restored.step_count();
+  if (file_step == step) lattice_ = std::move(restored);
+  return file_step;
 }
 
 }  // namespace bendlab
