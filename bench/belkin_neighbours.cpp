@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <ctime>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -52,7 +53,38 @@ int scaling(const std::vector<long>& sizes) {
   return 0;
 }
 
+// The stages of one Method D evaluation (best of five each): the mesh geometry, the operator's
+// set-up (neighbour lists), its application to x (apply_to_positions) and to a scalar field (as to H).
+int stages(const std::vector<long>& sizes) {
+  for (long triangles : sizes) {
+    const TriMesh m = sphere_mesh(MeshFamily::MT1, level_with_triangles(MeshFamily::MT1, triangles));
+    const Points x = make_rbc()->map_from_unit_sphere(m.positions());
+    double tg = 1e300, tb = 1e300, tx = 1e300, th = 1e300, td = 1e300;
+    const auto d = make_bending_method("D");
+    for (int rep = 0; rep < 5; ++rep) {
+      td = std::min(td, seconds([&] { d->compute(m.topology(), x, 1.0); }));
+      MeshGeometry g;
+      tg = std::min(tg, seconds([&] { g = MeshGeometry::compute(m.topology(), x); }));
+      std::unique_ptr<BelkinLaplacian> lap;
+      tb = std::min(tb, seconds([&] { lap = std::make_unique<BelkinLaplacian>(m.topology(), x, g); }));
+      Points lx;
+      tx = std::min(tx, seconds([&] { lx = lap->apply_to_positions(); }));
+      const Scalars H = lx.col(0);
+      th = std::min(th, seconds([&] { lap->apply(H); }));
+    }
+    fmt::print("triangles {:6d} | geometry {:.4f} s | set-up {:.4f} s | apply x {:.4f} s | apply H {:.4f} s | Method D {:.4f} s\n",
+               m.num_faces(), tg, tb, tx, th, td);
+  }
+  return 0;
+}
+
 int main(int argc, char** argv) {
+  if (argc >= 2 && std::string(argv[1]) == "stages") {
+    std::vector<long> sizes;
+    for (int k = 2; k < argc; ++k) sizes.push_back(std::stol(argv[k]));
+    if (sizes.empty()) sizes = {5120, 20480, 81920};
+    return stages(sizes);
+  }
   if (argc >= 2 && std::string(argv[1]) == "scaling") {
     std::vector<long> sizes;
     for (int k = 2; k < argc; ++k) sizes.push_back(std::stol(argv[k]));

@@ -89,13 +89,20 @@ class BelkinLaplacian {
                   BelkinOptions options = {});
   Scalars apply(const Scalars& w) const;
   Points apply(const Points& w) const;
+  /// Lap x: the operator applied to the positions it was built from (equal to apply(x) up to
+  /// rounding; the grid form reuses the differences p - x_i its kernel computes anyway).
+  Points apply_to_positions() const;
   /// Lumped weight of vertex p: one third of the area of the faces at p.
   const Scalars& lumped_area() const { return lumped_area_; }
 
  private:
   template <int Cols>
   void apply_columns(const double* const* w, double* const* out) const;
+  void apply_grid(const double* w, double* const* out) const;
   void build_grid();
+  /// Array j of the points in scan order (0, 1, 2: centred position; 3: |x_p - c|; 4: lumped
+  /// area), 64-byte aligned, padded by zeros.
+  const double* point_array(int j) const;
 
   BelkinOptions options_;
   int n_ = 0;
@@ -109,11 +116,16 @@ class BelkinLaplacian {
   double lo_[3] = {0, 0, 0};
   int dims_[3] = {1, 1, 1};
   // The points in scan order (grid: sorted by cell; reference: vertex order): order_[k] is the
-  // vertex at position k, s*_ its data. Vertex i scans the runs [runs_[r], runs_[r + 1]) for r in
-  // [run_start_[i], run_start_[i + 1]) step 2 (run_shared_: every vertex the one run runs_[0..1]).
+  // vertex at position k, point_array its data. Vertex i scans the runs [runs_[r], runs_[r + 1])
+  // for r in [run_start_[i], run_start_[i + 1]) step 2 (run_shared_: every vertex the one run
+  // runs_[0..1]).
   std::vector<int> order_, run_start_, runs_;
   bool run_shared_ = false;
-  std::vector<double> sx_, sy_, sz_, snorm_, slump_;
+  std::size_t stride_ = 0;        ///< distance between the point arrays in points_
+  std::vector<double> points_;    ///< the five point arrays (point_array)
+  /// Grid form: 1 where vertex i's ball crosses the half-space plane (the kernel tests each
+  /// point), 0 where every point within its cut-off radius lies above it.
+  std::vector<unsigned char> plane_test_;
 };
 
 /// Method D: normal = MWA; H by eq. (2) with eq. (13) (H = -1/2 (Lap x) . n); lapH by eq. (13)
