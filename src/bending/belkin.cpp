@@ -25,6 +25,8 @@ constexpr double kMaxExponent = 80.0;
 // the result would change under a rotation or a scaling of the shape. Such nodes are left out, as
 // the strict inequality of the rule says for points on the plane.
 constexpr double kPlaneTolerance = 1e-9;
+// The grid form's cells are this many times shorter along x (the rows) than across (build_grid).
+constexpr double kRowCellDivisor = 2.0;
 
 // exp(-e) for 0 <= e <= 80 (the kept terms), branch-free so that the kernel loop vectorises:
 // -e = n ln 2 + r with n = round(-e / ln 2) (|n| <= 116, so 2^n is a normal double) and
@@ -278,9 +280,12 @@ void BelkinLaplacian::build_grid() {
     run_start_.assign(1, 0);
     return;
   }
-  // Cells of 0.35 times the median cut-off radius: a vertex scans the rows of cells that meet its
-  // ball; smaller cells read fewer points outside the ball (measured at 81920 triangles: 680
-  // points per vertex at 0.35, 800 at 0.5, about 440 inside the ball) but make more, shorter runs.
+  // Cells of 0.35 times the median cut-off radius across the rows (y, z) and half that along them
+  // (x): a vertex scans the rows of cells that meet its ball; smaller cells read fewer points
+  // outside the ball (measured at 81920 triangles with cubic cells: 680 points per vertex at 0.35,
+  // 800 at 0.5, about 440 inside the ball) but make more, shorter runs, and more rows to list.
+  // Shorter cells along x only trim the ends of the runs, at no cost in rows (measured: the two
+  // applies 4 to 15 % faster than with cubic cells; 0.35 across measured best among 0.3 to 0.6).
   std::vector<double> r(n_);
   for (int i = 0; i < n_; ++i) r[i] = std::sqrt(4.0 * kernel_area_[i] * max_exponent_);
   std::vector<double> sorted = r;
@@ -295,16 +300,17 @@ void BelkinLaplacian::build_grid() {
   // At most about 4 cells per vertex (and 1024 per axis), whatever the spread of a_i.
   const double max_cells = 4.0 * n_ + 64;
   for (;;) {
+    const double side[3] = {cell / kRowCellDivisor, cell, cell};
     double count = 1;
-    for (int d = 0; d < 3; ++d) count *= std::floor((hi[d] - lo_[d]) / cell) + 1;
+    for (int d = 0; d < 3; ++d) count *= std::floor((hi[d] - lo_[d]) / side[d]) + 1;
     bool ok = count <= max_cells && cell > 0;
-    for (int d = 0; d < 3; ++d) ok = ok && (hi[d] - lo_[d]) / cell < 1023;
+    for (int d = 0; d < 3; ++d) ok = ok && (hi[d] - lo_[d]) / side[d] < 1023;
     if (ok) break;
     cell = cell > 0 ? 1.25 * cell : 1.0;
   }
-  cell_ = cell;
-  for (int d = 0; d < 3; ++d) dims_[d] = static_cast<int>(std::floor((hi[d] - lo_[d]) / cell_)) + 1;
-  auto coord = [&](double v, int d) { return std::clamp(static_cast<int>(std::floor((v - lo_[d]) / cell_)), 0, dims_[d] - 1); };
+  cell_[0] = cell / kRowCellDivisor, cell_[1] = cell, cell_[2] = cell;
+  for (int d = 0; d < 3; ++d) dims_[d] = static_cast<int>(std::floor((hi[d] - lo_[d]) / cell_[d])) + 1;
+  auto coord = [&](double v, int d) { return std::clamp(static_cast<int>(std::floor((v - lo_[d]) / cell_[d])), 0, dims_[d] - 1); };
   const int ncells = dims_[0] * dims_[1] * dims_[2];
   std::vector<int> cell_of(n_), cell_start(ncells + 1, 0);
   for (int p = 0; p < n_; ++p) {
@@ -330,8 +336,8 @@ void BelkinLaplacian::build_grid() {
   // indices may be rounded outwards: truncation instead of floor, clamped to the grid. Each
   // thread lists a contiguous range of vertices; the lists are joined in vertex order.
   const int nx = dims_[0], ny = dims_[1], nz = dims_[2];
-  const double inv_cell = 1.0 / cell_;
-  auto cell_index = [&](double v, int d) { return static_cast<int>((v - lo_[d]) * inv_cell); };
+  const double inv_cell[3] = {1.0 / cell_[0], 1.0 / cell_[1], 1.0 / cell_[2]};
+  auto cell_index = [&](double v, int d) { return static_cast<int>((v - lo_[d]) * inv_cell[d]); };
   run_start_.assign(n_ + 1, 0);
   std::vector<std::vector<int>> parts(omp_get_max_threads());
 #pragma omp parallel
@@ -346,7 +352,7 @@ void BelkinLaplacian::build_grid() {
       const double r2 = r[i] * r[i], ri = r[i];
       // Distance from v to the interval of cell c along axis d.
       auto gap = [&](double v, int d, int c) {
-        const double l = lo_[d] + c * cell_, h = l + cell_;
+        const double l = lo_[d] + c * cell_[d], h = l + cell_[d];
         return v < l ? l - v : (v > h ? v - h : 0.0);
       };
       const std::size_t first = runs.size();
@@ -378,9 +384,13 @@ void BelkinLaplacian::build_grid() {
   }
   // Joined: vertex i's runs at [run_start_[i], run_start_[i + 1]).
   for (int i = 0; i < n_; ++i) run_start_[i + 1] += run_start_[i];
-  runs_.clear();
-  runs_.reserve(run_start_[n_]);
-  for (const std::vector<int>& part : parts) runs_.insert(runs_.end(), part.begin(), part.end());
+  if (parts.size() == 1) {
+    runs_ = std::move(parts[0]);
+  } else {
+    runs_.clear();
+    runs_.reserve(run_start_[n_]);
+    for (const std::vector<int>& part : parts) runs_.insert(runs_.end(), part.begin(), part.end());
+  }
   run_shared_ = false;
 }
 

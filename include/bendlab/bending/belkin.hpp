@@ -111,8 +111,8 @@ class BelkinLaplacian {
   Scalars lumped_area_;
   Scalars kernel_area_;               ///< a_i = A_mixed_i
   double max_exponent_ = 80;  ///< -ln(kernel_cutoff), at most 80 (the reference: 80)
-  // The grid form: cells of side cell_ from lo_, dims_[0] x dims_[1] x dims_[2], x fastest.
-  double cell_ = 0;
+  // The grid form: cells of sides cell_[0..2] from lo_, dims_[0] x dims_[1] x dims_[2], x fastest.
+  double cell_[3] = {0, 0, 0};
   double lo_[3] = {0, 0, 0};
   int dims_[3] = {1, 1, 1};
   // The points in scan order (grid: sorted by cell; reference: vertex order): order_[k] is the
