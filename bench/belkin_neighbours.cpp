@@ -6,9 +6,14 @@
 //
 //   belkin_neighbours TRIANGLES [CUTOFF ...] [skip-all]   (CUTOFF default 1e-15; skip-all: no reference)
 //   belkin_neighbours scaling [TRIANGLES ...]             (default 5120 20480 81920)
+//   belkin_neighbours stages [TRIANGLES ...]              (default 5120 20480 81920)
 // The second form times Method C and Method D (grid, default cutoff) per size, each the best of
 // three evaluations, and prints D's time per vertex (constant for O(N)) and the ratio D / C. Run it
-// with OMP_NUM_THREADS=1 for the one-thread ratio.
+// with OMP_NUM_THREADS=1 for the one-thread ratio. The third times the parts of Method D (best of
+// five each): the mesh geometry, the operator's set-up, Lap x and Lap of a scalar field.
+// On a machine where first touch of fresh memory is slow (a virtual machine: 17 us per 4 KiB
+// page measured), glibc returning freed memory between evaluations weighs on both methods;
+// MALLOC_TRIM_THRESHOLD_=4000000000 MALLOC_MMAP_THRESHOLD_=4000000000 keeps it (belkin.hpp).
 #include <fmt/format.h>
 
 #include <algorithm>

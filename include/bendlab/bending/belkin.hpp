@@ -23,32 +23,49 @@
 // - grid (the default, O(N)): terms whose kernel weight exp(-|p - x_i|^2 / (4 a_i)) is below
 //   kernel_cutoff (method option "kernel_cutoff", default 1e-15) are dropped, so vertex i only
 //   sees the points within r_i = sqrt(4 a_i ln(1 / kernel_cutoff)), found through a uniform grid
-//   of cells (a cell list sorted by cell, cells of half the median r_i). With a_i ~ A_total / N the
+//   of cells (a cell list sorted by cell; cell sizes below). With a_i ~ A_total / N the
 //   ball holds about 4 pi ln(1/cutoff) vertices (about 430 at the default) whatever N: O(N).
 //   The neighbour lists (for each vertex, the runs of cell-sorted points, one per row of cells
-//   meeting its ball) are built once per shape, when the operator is constructed, and serve every
-//   apply() (Method D applies it to x and to H).
+//   meeting its ball; cells 0.35 median r_i across the rows and half that along them) are built
+//   once per shape, when the operator is constructed, and serve every apply() (Method D applies
+//   it to x, apply_to_positions(), and to H).
 //   Truncation error: each of the at most N dropped terms has weight A_p * exp(-exponent) <=
 //   A_p * cutoff and |w(p) - w(x_i)| <= 2 max|w|, so (Lap w)_i changes by at most
 //       cutoff * (sum of the dropped A_p) * 2 max|w| / (4 pi a_i^2)
 //     <= cutoff * A_total * 2 max|w| / (4 pi a_i^2)  ~  cutoff * N * max|w| / (2 pi a_i)
 //   (A_total / a_i ~ N); for the 5120-triangle red blood cell (A_total = 8.76, a_i >= 1.3e-3)
 //   that is at most 1e-15 * 8.76 * 2 / (4 pi 1.8e-6) ~ 8e-10 max|w|, against max|Lap x| =
-//   2 max|H| = 4.4. In practice far less (the dropped weights decay like a Gaussian beyond r_i):
-//   measured max-norm differences from the reference, relative, for Method D's f on the red
-//   blood cell: 3e-14 (1280 triangles), 3e-13 (5120), 1.3e-12 (20480), 7.5e-12 (81920); with
-//   cutoff 1e-12 they are 3e-11, 1.6e-10, 7e-10, 5.9e-9 (bench/belkin_neighbours).
+//   2 max|H| = 4.4. In practice far less (the dropped weights decay like a Gaussian beyond r_i).
+//   Measured max-norm differences from the reference, relative, for Method D's f on the red blood
+//   cell (bench/belkin_neighbours TRIANGLES): 3e-14 (1280 triangles), 2.9e-13 (5120), 1.7e-12
+//   (20480), 1.8e-11 (81920); H within 1.1e-13 at every size. (The cut-off alone, with the
+//   reference's exponential: 7.5e-12 at 81920; with cutoff 1e-12: 5.9e-9, too close to 1e-8.)
 //   Values below e^-80 are clamped to e^-80, the reference's own cut, so that both forms keep the
-//   same terms and differ only by the order of the sum.
-// Both forms run one kernel loop (belkin.cpp): over blocks of points of a run, branch-free, the
-// exponent, the half-space and cut-off tests as a 0/1 factor and the exponential by a polynomial
-// (within an ulp of exp, measured over [0, 80]), so that it vectorises (AVX-512, AVX2 or
-// baseline, chosen at run time). One Method D evaluation on the red blood cell, one thread, best
-// of several, processor time on the shared 2-core machine (bench/belkin_neighbours scaling):
-// 81920 triangles 0.105 to 0.14 s against Method C's 0.009 to 0.013 s (12 to 16 times C; the
-// all-pairs reference 4.6 s); 3.6 to 4.5 us per vertex from 5120 to 81920 triangles (linear).
-// The same build before the lists were kept and the loop vectorised: 0.55 to 0.60 s (62 times C).
-// Both are deterministic; they differ only by the order of the sum and the dropped terms.
+//   same terms and differ only by the order of the sum and the exponential below.
+// Kernels (belkin.cpp), branch-free over blocks of points of a run (the exponent, the cut-off,
+// the run's end and the half-space test as a mask) so that they vectorise (AVX-512, AVX2 or
+// baseline, chosen at run time):
+// - all: blocks of 16, exp by a polynomial within an ulp of std::exp (measured over [0, 80]).
+// - grid: blocks of 8 (one AVX-512 register; the runs are short), the exponential in base 2 by a
+//   polynomial of degree 11 (relative error below 1e-14), the half-space test only for vertices
+//   whose ball crosses the plane (elsewhere every point of the ball passes it: the same terms),
+//   and for Lap x the differences p - x_i the distance is made of.
+// One Method D evaluation on the red blood cell, one thread, processor time on the shared 2-core
+// machine, best of three, D and C timed in turn by
+//   OMP_NUM_THREADS=1 build/release/belkin_neighbours scaling
+// 5120 / 20480 / 81920 triangles: D 0.0075 / 0.031 / 0.131 s, C 0.0021 / 0.0092 / 0.040 s,
+// D / C 3.4-3.9 / 3.2-3.4 / 3.2-3.3, 2.9-3.2 us per vertex (linear). Most of C's time there, and
+// about 0.06 s of D's, is first touch of freshly allocated memory (17 us per 4 KiB page measured
+// on that virtual machine); with glibc keeping freed memory
+//   (MALLOC_TRIM_THRESHOLD_=4000000000 MALLOC_MMAP_THRESHOLD_=4000000000, same command)
+// D 0.0044 / 0.017 / 0.071-0.074 s, C 0.0005 / 0.0023 / 0.0097-0.0104 s: D / C 9-10 / 7.4-8.2 /
+// 6.8-7.6. The parts of D at 81920 triangles (belkin_neighbours stages 81920, memory kept): mesh
+// geometry 0.0085 s (as C's), set-up 0.013 s, Lap x 0.026 s, Lap H 0.025 s.
+// Before this kernel (cubic cells, one kernel for both forms): D 0.16-0.17 s against C's 0.010 s
+// in the same run (16-17 times C; the stages 0.015 / 0.041 / 0.034 s); before the lists were kept
+// and the loop vectorised: 0.55 to 0.60 s (62 times C). The all-pairs reference: 3.8 s.
+// Both are deterministic; they differ only by the order of the sum, the exponential and the
+// dropped terms.
 // The operator of a constant is exactly zero in both (every term carries w(p) - w(x_i) = 0).
 #include <memory>
 #include <vector>
