@@ -12,8 +12,9 @@
 // with OMP_NUM_THREADS=1 for the one-thread ratio. The third times the parts of Method D (best of
 // five each): the mesh geometry, the operator's set-up, Lap x and Lap of a scalar field.
 // On a machine where first touch of fresh memory is slow (a virtual machine: 17 us per 4 KiB
-// page measured), glibc returning freed memory between evaluations weighs on both methods;
-// MALLOC_TRIM_THRESHOLD_=4000000000 MALLOC_MMAP_THRESHOLD_=4000000000 keeps it (belkin.hpp).
+// page measured), what glibc returns to the system between evaluations, which depends on what the
+// other method freed, can dominate either time; set MALLOC_TRIM_THRESHOLD_=4000000000
+// MALLOC_MMAP_THRESHOLD_=4000000000 to keep freed memory (belkin.hpp).
 #include <fmt/format.h>
 
 #include <algorithm>

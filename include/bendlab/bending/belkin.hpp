@@ -51,21 +51,22 @@
 //   whose ball crosses the plane (elsewhere every point of the ball passes it: the same terms),
 //   and for Lap x the differences p - x_i the distance is made of.
 // One Method D evaluation on the red blood cell, one thread, processor time on the shared 2-core
-// machine, best of three, D and C timed in turn by
+// machine, best of three, D and C timed in turn, with glibc keeping freed memory:
+//   MALLOC_TRIM_THRESHOLD_=4000000000 MALLOC_MMAP_THRESHOLD_=4000000000 \
 //   OMP_NUM_THREADS=1 build/release/belkin_neighbours scaling
-// 5120 / 20480 / 81920 triangles: D 0.0069-0.0073 / 0.030-0.031 / 0.122-0.125 s, C 0.0020 /
-// 0.0091-0.0101 / 0.041 s, D / C 3.4-3.8 / 3.0-3.4 / 3.0, 2.7-3.0 us per vertex (linear). Most of
-// C's time there, and about 0.06 s of D's, is first touch of freshly allocated memory (17 us per
-// 4 KiB page measured on that virtual machine). With glibc keeping freed memory
-//   (MALLOC_TRIM_THRESHOLD_=4000000000 MALLOC_MMAP_THRESHOLD_=4000000000, same command)
-// D 0.0039 / 0.0155 / 0.063-0.065 s (1.5 us per vertex), C 0.0004 / 0.0020-0.0024 / 0.0087-0.0091
-// s: D / C 8.8-9.5 / 6.4-7.6 / 7.0-7.4; bench_bending's BM_Forces (repeated evaluations, processor
-// time) agrees: D / C 10 / 9.0 / 7.1 (3.97 / 15.6 / 67.0 ms against 0.39 / 1.73 / 9.49 ms). The
-// parts of D at 81920 triangles (belkin_neighbours stages 81920, memory kept): mesh geometry
-// 0.008 s (as C's), set-up 0.013 s, Lap x 0.022 s, Lap H 0.020 s.
-// Before this kernel (cubic cells, one kernel for both forms): D 0.16-0.17 s against C's 0.010 s
-// in the same run (16-17 times C; the stages 0.015 / 0.041 / 0.034 s); before the lists were kept
-// and the loop vectorised: 0.55 to 0.60 s (62 times C). The all-pairs reference: 3.8 s.
+// 5120 / 20480 / 81920 triangles: D 0.0039 / 0.0155 / 0.063-0.070 s (1.5-1.7 us per vertex,
+// linear), C 0.0004 / 0.0020-0.0024 / 0.0087-0.0099 s: D / C 8.8-9.5 / 6.4-7.6 / 7.0-7.4. The
+// previous kernel (cubic cells, one kernel for both forms), same command, same time: D 0.110-0.115
+// s, 10.4-10.9 times C; before the lists were kept and the loop vectorised: 0.55 to 0.60 s. The
+// all-pairs reference: 3.8 s. bench_bending's BM_Forces (repeated evaluations, processor time)
+// agrees: D / C 10 / 9.0 / 7.1 (3.97 / 15.6 / 67.0 ms against 0.39 / 1.73 / 9.49 ms). The parts of
+// D at 81920 triangles (belkin_neighbours stages 81920, memory kept): mesh geometry 0.008 s (as
+// C's), set-up 0.013 s, Lap x 0.022 s, Lap H 0.020 s.
+// Without the two variables the same run is not a measure of D: first touch of fresh memory costs
+// 17 us per 4 KiB page on that virtual machine, and what glibc hands back between evaluations
+// depends on what the other method freed. Measured there: with this code C 0.041-0.060 s after D
+// (D 0.122-0.167 s, ratio 2.7-3.0), with the previous code C 0.011-0.016 s (D 0.19-0.23 s, ratio
+// 14-18); the C code is the same.
 // Both are deterministic; they differ only by the order of the sum, the exponential and the
 // dropped terms.
 // The operator of a constant is exactly zero in both (every term carries w(p) - w(x_i) = 0).
