@@ -52,8 +52,8 @@
 //   and for Lap x the differences p - x_i the distance is made of.
 // One Method D evaluation on the red blood cell, one thread, processor time on the shared 2-core
 // machine, best of three, D and C timed in turn, with glibc keeping freed memory:
-//   MALLOC_TRIM_THRESHOLD_=4000000000 MALLOC_MMAP_THRESHOLD_=4000000000 \
-//   OMP_NUM_THREADS=1 build/release/belkin_neighbours scaling
+//   MALLOC_TRIM_THRESHOLD_=4000000000 MALLOC_MMAP_THRESHOLD_=4000000000 OMP_NUM_THREADS=1
+//   build/release/belkin_neighbours scaling   (one command line)
 // 5120 / 20480 / 81920 triangles: D 0.0039 / 0.0155 / 0.063-0.070 s (1.5-1.7 us per vertex,
 // linear), C 0.0004 / 0.0020-0.0024 / 0.0087-0.0099 s: D / C 8.8-9.5 / 6.4-7.6 / 7.0-7.4. The
 // previous kernel (cubic cells, one kernel for both forms), same command, same time: D 0.110-0.115
