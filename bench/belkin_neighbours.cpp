@@ -6,13 +6,20 @@
 //
 //   belkin_neighbours TRIANGLES [CUTOFF ...] [skip-all]   (CUTOFF default 1e-15; skip-all: no reference)
 //   belkin_neighbours scaling [TRIANGLES ...]             (default 5120 20480 81920)
+//   belkin_neighbours stages [TRIANGLES ...]              (default 5120 20480 81920)
 // The second form times Method C and Method D (grid, default cutoff) per size, each the best of
 // three evaluations, and prints D's time per vertex (constant for O(N)) and the ratio D / C. Run it
-// with OMP_NUM_THREADS=1 for the one-thread ratio.
+// with OMP_NUM_THREADS=1 for the one-thread ratio. The third times the parts of Method D (best of
+// five each): the mesh geometry, the operator's set-up, Lap x and Lap of a scalar field.
+// On a machine where first touch of fresh memory is slow (a virtual machine: 17 us per 4 KiB
+// page measured), what glibc returns to the system between evaluations, which depends on what the
+// other method freed, can dominate either time; set MALLOC_TRIM_THRESHOLD_=4000000000
+// MALLOC_MMAP_THRESHOLD_=4000000000 to keep freed memory (belkin.hpp).
 #include <fmt/format.h>
 
 #include <algorithm>
 #include <ctime>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -52,7 +59,38 @@ int scaling(const std::vector<long>& sizes) {
   return 0;
 }
 
+// The stages of one Method D evaluation (best of five each): the mesh geometry, the operator's
+// set-up (neighbour lists), its application to x (apply_to_positions) and to a scalar field (as to H).
+int stages(const std::vector<long>& sizes) {
+  for (long triangles : sizes) {
+    const TriMesh m = sphere_mesh(MeshFamily::MT1, level_with_triangles(MeshFamily::MT1, triangles));
+    const Points x = make_rbc()->map_from_unit_sphere(m.positions());
+    double tg = 1e300, tb = 1e300, tx = 1e300, th = 1e300, td = 1e300;
+    const auto d = make_bending_method("D");
+    for (int rep = 0; rep < 5; ++rep) {
+      td = std::min(td, seconds([&] { d->compute(m.topology(), x, 1.0); }));
+      MeshGeometry g;
+      tg = std::min(tg, seconds([&] { g = MeshGeometry::compute(m.topology(), x); }));
+      std::unique_ptr<BelkinLaplacian> lap;
+      tb = std::min(tb, seconds([&] { lap = std::make_unique<BelkinLaplacian>(m.topology(), x, g); }));
+      Points lx;
+      tx = std::min(tx, seconds([&] { lx = lap->apply_to_positions(); }));
+      const Scalars H = lx.col(0);
+      th = std::min(th, seconds([&] { lap->apply(H); }));
+    }
+    fmt::print("triangles {:6d} | geometry {:.4f} s | set-up {:.4f} s | apply x {:.4f} s | apply H {:.4f} s | Method D {:.4f} s\n",
+               m.num_faces(), tg, tb, tx, th, td);
+  }
+  return 0;
+}
+
 int main(int argc, char** argv) {
+  if (argc >= 2 && std::string(argv[1]) == "stages") {
+    std::vector<long> sizes;
+    for (int k = 2; k < argc; ++k) sizes.push_back(std::stol(argv[k]));
+    if (sizes.empty()) sizes = {5120, 20480, 81920};
+    return stages(sizes);
+  }
   if (argc >= 2 && std::string(argv[1]) == "scaling") {
     std::vector<long> sizes;
     for (int k = 2; k < argc; ++k) sizes.push_back(std::stol(argv[k]));

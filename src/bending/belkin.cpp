@@ -9,6 +9,8 @@
 #include <numeric>
 #include <string>
 
+#include <omp.h>
+
 #include "bendlab/bending/variational_assembly.hpp"
 #include "bendlab/geometry/measures.hpp"
 
@@ -23,6 +25,8 @@ constexpr double kMaxExponent = 80.0;
 // the result would change under a rotation or a scaling of the shape. Such nodes are left out, as
 // the strict inequality of the rule says for points on the plane.
 constexpr double kPlaneTolerance = 1e-9;
+// The grid form's cells are this many times shorter along x (the rows) than across (build_grid).
+constexpr double kRowCellDivisor = 2.0;
 
 // exp(-e) for 0 <= e <= 80 (the kept terms), branch-free so that the kernel loop vectorises:
 // -e = n ln 2 + r with n = round(-e / ln 2) (|n| <= 116, so 2^n is a normal double) and
@@ -64,7 +68,7 @@ struct KernelInput {
   bool half_space;
 };
 
-// Sum over the points of the runs [runs[2r], runs[2r + 1]), r < nruns, of
+// The reference form's kernel. Sum over the points of the runs [runs[2r], runs[2r + 1]), r < nruns, of
 // A_p exp(-|p - x_i|^2 / (4 a_i)) (w(p) - w(x_i)) for the kept terms (exponent <= emax, and p
 // above the plane of x_i under the half-space rule), into acc. Branch-free: blocks of kLanes
 // points (the point arrays are padded by kLanes entries), points past the run's end and masked
@@ -106,6 +110,85 @@ __attribute__((always_inline)) inline void run_sum_body(const KernelInput& in, c
   }
 }
 
+// 2^-y for 0 <= y <= 116 (the grid form's kernel weights, y = exponent / ln 2), branch-free:
+// y = m + g with m = round(y) (so 2^-m is a normal double) and |g| <= 1/2 exact (Sterbenz);
+// 2^-g = exp(u), u = -g ln 2 in [-ln 2 / 2, ln 2 / 2], by the degree-9 polynomial interpolating
+// exp at the Chebyshev points of that interval (coefficients from numpy's chebinterpolate,
+// converted to powers of u): relative error within 2.3e-14 (measured against exp2l on 2e7
+// points of [0, 116]), against which the grid form's 1e-8 agreement with the reference has ample room
+// (the reference keeps exp_neg above, within an ulp). 2^-m put into the exponent bits.
+inline double exp2_neg(double y) {
+  constexpr double shifter = 6755399441055744.0;  // 1.5 * 2^52: adding it rounds to an integer
+  const double t = shifter - y;                   // low bits: -m (two's complement)
+  const double g = (t - shifter) + y;             // -m + y = g, exact
+  const double u = -g * 0.69314718055994530942;   // -g ln 2
+  double p = 2.7626751247900033e-06;
+  p = p * u + 2.488377337960311e-05;
+  p = p * u + 0.00019841202022427646;
+  p = p * u + 0.0013888803088674226;
+  p = p * u + 0.008333333360990468;
+  p = p * u + 0.04166666703318375;
+  p = p * u + 0.16666666666626692;
+  p = p * u + 0.4999999999944954;
+  p = p * u + 1.0000000000000002;
+  p = p * u + 1.000000000000013;
+  const std::uint64_t bits = (std::bit_cast<std::uint64_t>(t) + 1023) << 52;
+  return p * std::bit_cast<double>(bits);
+}
+
+// What the grid form's kernel reads for one vertex.
+struct GridInput {
+  const double *sx, *sy, *sz, *sn, *sl;  // points in scan order: centred position, |x_p - c|, lumped area
+  const double* w;                       // a scalar field in scan order (Field::scalar)
+  double xi, yi, zi, margin, scale, ymax, wi;
+};
+enum class Field { scalar, positions };
+
+// The grid form's kernel: the sum of eq. (13) for one vertex over its runs, as run_sum_body but
+// in blocks of kGridLanes (one AVX-512 register: the runs are short, about 35 points), with the
+// exponent in base 2 (y = |p - x_i|^2 log2(e) / (4 a_i), kept where y <= ymax, exp2_neg), the
+// half-space test only where the vertex's ball crosses the plane (Plane), and for
+// Field::positions w(p) - w(x_i) = p - x_i, the differences the distance is made of (Lap x).
+constexpr int kGridLanes = 8;
+template <Field Kind, bool Plane>
+__attribute__((always_inline)) inline void grid_sum_body(const GridInput& in, const int* runs, int nruns,
+                                                         double* acc) {
+  const double *sx = in.sx, *sy = in.sy, *sz = in.sz, *sn = in.sn, *sl = in.sl, *w = in.w;
+  const double xi = in.xi, yi = in.yi, zi = in.zi, margin = in.margin, scale = in.scale, ymax = in.ymax;
+  const double wi = in.wi;
+  double a0[kGridLanes] = {}, a1[kGridLanes] = {}, a2[kGridLanes] = {};
+  for (int r = 0; r < nruns; ++r) {
+    // 64-bit indices: with 32-bit ones the vectoriser picks 256-bit registers for 8 lanes.
+    const std::int64_t k1 = runs[2 * r + 1];
+    for (std::int64_t k0 = runs[2 * r]; k0 < k1; k0 += kGridLanes) {
+#pragma omp simd
+      for (std::int64_t l = 0; l < kGridLanes; ++l) {
+        const std::int64_t k = k0 + l;
+        const double dx = sx[k] - xi, dy = sy[k] - yi, dz = sz[k] - zi;
+        const double y = (dx * dx + dy * dy + dz * dz) * scale;
+        bool keep = (y <= ymax) & (k < k1);
+        if constexpr (Plane) keep = keep & (sx[k] * xi + sy[k] * yi + sz[k] * zi > margin * sn[k]);
+        const double lump = sl[k], kernel = exp2_neg(std::min(y, ymax));
+        const double weight = (keep ? lump : 0.0) * kernel;
+        if constexpr (Kind == Field::scalar) {
+          a0[l] += weight * (w[k] - wi);
+        } else {
+          a0[l] += weight * dx;
+          a1[l] += weight * dy;
+          a2[l] += weight * dz;
+        }
+      }
+    }
+  }
+  for (int l = 0; l < kGridLanes; ++l) {
+    acc[0] += a0[l];
+    if constexpr (Kind == Field::positions) {
+      acc[1] += a1[l];
+      acc[2] += a2[l];
+    }
+  }
+}
+
 // Compiled for AVX-512, AVX2+FMA and baseline x86-64 and picked at run time (as the boundary
 // integral's kernel, stokes_single_layer.cpp).
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
@@ -119,6 +202,24 @@ BENDLAB_KERNEL_CLONES void run_sum1(const KernelInput& in, const int* runs, int 
 BENDLAB_KERNEL_CLONES void run_sum3(const KernelInput& in, const int* runs, int nruns, double* acc) {
   run_sum_body<3>(in, runs, nruns, acc);
 }
+BENDLAB_KERNEL_CLONES void grid_sum_scalar(const GridInput& in, const int* runs, int nruns, double* acc) {
+  grid_sum_body<Field::scalar, false>(in, runs, nruns, acc);
+}
+BENDLAB_KERNEL_CLONES void grid_sum_scalar_plane(const GridInput& in, const int* runs, int nruns, double* acc) {
+  grid_sum_body<Field::scalar, true>(in, runs, nruns, acc);
+}
+BENDLAB_KERNEL_CLONES void grid_sum_positions(const GridInput& in, const int* runs, int nruns, double* acc) {
+  grid_sum_body<Field::positions, false>(in, runs, nruns, acc);
+}
+BENDLAB_KERNEL_CLONES void grid_sum_positions_plane(const GridInput& in, const int* runs, int nruns, double* acc) {
+  grid_sum_body<Field::positions, true>(in, runs, nruns, acc);
+}
+
+// A 64-byte aligned position in a buffer of doubles with 8 spare entries at its start.
+inline double* aligned64(double* p) {
+  return p + (64 - reinterpret_cast<std::uintptr_t>(p) % 64) % 64 / sizeof(double);
+}
+inline const double* aligned64(const double* p) { return aligned64(const_cast<double*>(p)); }
 }  // namespace
 
 BelkinLaplacian::BelkinLaplacian(const Topology& topology, const Points& x, const MeshGeometry& geometry,
@@ -141,6 +242,12 @@ BelkinLaplacian::BelkinLaplacian(const Topology& topology, const Points& x, cons
   for (int f = 0; f < topology.num_faces(); ++f)
     for (int k = 0; k < 3; ++k) lumped_area_[F(f, k)] += geometry.face_area[f] / 3.0;
   kernel_area_ = geometry.mixed_area;
+  // The point arrays, each padded by kLanes zeros (the kernels read whole blocks), an odd number
+  // of cache lines apart (arrays a multiple of 4 KiB apart make the kernels' loads of one point
+  // collide in the cache).
+  stride_ = (static_cast<std::size_t>(n_) + kLanes + 7) / 8 * 8;
+  if (stride_ / 8 % 2 == 0) stride_ += 8;
+  points_.assign(5 * stride_ + 8, 0.0);
   if (options_.neighbours == BelkinOptions::Neighbours::grid) {
     if (!(options_.kernel_cutoff > 0) || !(options_.kernel_cutoff < 1))
       throw Error("belkin_laplacian: kernel_cutoff must be in (0, 1), got " + std::to_string(options_.kernel_cutoff));
@@ -151,22 +258,33 @@ BelkinLaplacian::BelkinLaplacian(const Topology& topology, const Points& x, cons
     max_exponent_ = kMaxExponent;
     order_.resize(n_);
     for (int p = 0; p < n_; ++p) order_[p] = p;
-    sx_ = qx_, sy_ = qy_, sz_ = qz_, snorm_ = qnorm_;
-    slump_.assign(lumped_area_.data(), lumped_area_.data() + n_);
-    for (auto* v : {&sx_, &sy_, &sz_, &snorm_, &slump_}) v->resize(n_ + kLanes, 0.0);  // padding, as build_grid
     runs_ = {0, n_};
     run_shared_ = true;
   }
+  double* arrays = aligned64(points_.data());
+  for (int k = 0; k < n_; ++k) {
+    const int p = order_[k];
+    arrays[k] = qx_[p];
+    arrays[stride_ + k] = qy_[p];
+    arrays[2 * stride_ + k] = qz_[p];
+    arrays[3 * stride_ + k] = qnorm_[p];
+    arrays[4 * stride_ + k] = lumped_area_[p];
+  }
 }
+
+const double* BelkinLaplacian::point_array(int j) const { return aligned64(points_.data()) + j * stride_; }
 
 void BelkinLaplacian::build_grid() {
   if (n_ == 0) {
     run_start_.assign(1, 0);
     return;
   }
-  // Cells of 0.35 times the median cut-off radius: a vertex scans the rows of cells that meet its
-  // ball; smaller cells read fewer points outside the ball (measured at 81920 triangles: 680
-  // points per vertex at 0.35, 800 at 0.5, about 440 inside the ball) but make more, shorter runs.
+  // Cells of 0.35 times the median cut-off radius across the rows (y, z) and half that along them
+  // (x): a vertex scans the rows of cells that meet its ball; smaller cells read fewer points
+  // outside the ball (measured at 81920 triangles with cubic cells: 680 points per vertex at 0.35,
+  // 800 at 0.5, about 440 inside the ball) but make more, shorter runs, and more rows to list.
+  // Shorter cells along x only trim the ends of the runs, at no cost in rows (measured: the two
+  // applies 4 to 15 % faster than with cubic cells; 0.35 across measured best among 0.3 to 0.6).
   std::vector<double> r(n_);
   for (int i = 0; i < n_; ++i) r[i] = std::sqrt(4.0 * kernel_area_[i] * max_exponent_);
   std::vector<double> sorted = r;
@@ -181,16 +299,17 @@ void BelkinLaplacian::build_grid() {
   // At most about 4 cells per vertex (and 1024 per axis), whatever the spread of a_i.
   const double max_cells = 4.0 * n_ + 64;
   for (;;) {
+    const double side[3] = {cell / kRowCellDivisor, cell, cell};
     double count = 1;
-    for (int d = 0; d < 3; ++d) count *= std::floor((hi[d] - lo_[d]) / cell) + 1;
+    for (int d = 0; d < 3; ++d) count *= std::floor((hi[d] - lo_[d]) / side[d]) + 1;
     bool ok = count <= max_cells && cell > 0;
-    for (int d = 0; d < 3; ++d) ok = ok && (hi[d] - lo_[d]) / cell < 1023;
+    for (int d = 0; d < 3; ++d) ok = ok && (hi[d] - lo_[d]) / side[d] < 1023;
     if (ok) break;
     cell = cell > 0 ? 1.25 * cell : 1.0;
   }
-  cell_ = cell;
-  for (int d = 0; d < 3; ++d) dims_[d] = static_cast<int>(std::floor((hi[d] - lo_[d]) / cell_)) + 1;
-  auto coord = [&](double v, int d) { return std::clamp(static_cast<int>(std::floor((v - lo_[d]) / cell_)), 0, dims_[d] - 1); };
+  cell_[0] = cell / kRowCellDivisor, cell_[1] = cell, cell_[2] = cell;
+  for (int d = 0; d < 3; ++d) dims_[d] = static_cast<int>(std::floor((hi[d] - lo_[d]) / cell_[d])) + 1;
+  auto coord = [&](double v, int d) { return std::clamp(static_cast<int>(std::floor((v - lo_[d]) / cell_[d])), 0, dims_[d] - 1); };
   const int ncells = dims_[0] * dims_[1] * dims_[2];
   std::vector<int> cell_of(n_), cell_start(ncells + 1, 0);
   for (int p = 0; p < n_; ++p) {
@@ -201,77 +320,80 @@ void BelkinLaplacian::build_grid() {
   order_.resize(n_);
   std::vector<int> fill(cell_start.begin(), cell_start.end() - 1);
   for (int p = 0; p < n_; ++p) order_[fill[cell_of[p]]++] = p;  // stable: ascending p in a cell
-  // Padded by kLanes entries of lumped area 0 (the kernel reads whole blocks).
-  for (auto* v : {&sx_, &sy_, &sz_, &snorm_, &slump_}) v->assign(n_ + kLanes, 0.0);
-  for (int k = 0; k < n_; ++k) {
-    const int p = order_[k];
-    sx_[k] = qx_[p], sy_[k] = qy_[p], sz_[k] = qz_[p], snorm_[k] = qnorm_[p], slump_[k] = lumped_area_[p];
+  // The half-space test is needed only where the ball crosses the plane: for |p - x_i| <= r_i,
+  // (p - c).(x_i - c) >= |x_i - c| (|x_i - c| - r_i) and |p - c| <= |x_i - c| + r_i, so every
+  // point of the ball passes the test of the kernel when |x_i - c| - r_i > 1e-9 (|x_i - c| + r_i);
+  // checked with 1e-6 and r_i enlarged by 1e-3 (the kernel's y <= ymax rounds), far beyond rounding.
+  plane_test_.assign(n_, 0);
+  for (int i = 0; i < n_; ++i) {
+    const double ri = 1.001 * r[i];
+    plane_test_[i] = options_.half_space && !(qnorm_[i] - ri > 1e-6 * (qnorm_[i] + ri));
   }
   // The neighbour lists, once per shape: for each vertex, the runs of sorted points (one per row
   // of cells) that meet its ball of radius r_i; every apply() scans only these. A run may hold
   // points outside the ball (the kernel tests every distance), never miss one inside, so cell
-  // indices may be rounded outwards: truncation instead of floor, clamped to the grid.
+  // indices may be rounded outwards: truncation instead of floor, clamped to the grid. Each
+  // thread lists a contiguous range of vertices; the lists are joined in vertex order.
   const int nx = dims_[0], ny = dims_[1], nz = dims_[2];
-  const double inv_cell = 1.0 / cell_;
-  auto cell_index = [&](double v, int d) { return static_cast<int>((v - lo_[d]) * inv_cell); };
-  // Room for every row of cells a vertex can meet: at most (2 r_i / cell + 2)^2 runs.
+  const double inv_cell[3] = {1.0 / cell_[0], 1.0 / cell_[1], 1.0 / cell_[2]};
+  auto cell_index = [&](double v, int d) { return static_cast<int>((v - lo_[d]) * inv_cell[d]); };
   run_start_.assign(n_ + 1, 0);
-  for (int i = 0; i < n_; ++i) {
-    const int rows = static_cast<int>(2.0 * r[i] * inv_cell) + 2;
-    run_start_[i + 1] = run_start_[i] + 2 * rows * rows;
-  }
-  std::vector<int> room(run_start_[n_]), used(n_, 0);
-#pragma omp parallel for schedule(dynamic, 256)
-  for (int i = 0; i < n_; ++i) {
-    const double xi = qx_[i], yi = qy_[i], zi = qz_[i];
-    const double r2 = r[i] * r[i], ri = r[i];
-    // Distance from v to the interval of cell c along axis d.
-    auto gap = [&](double v, int d, int c) {
-      const double l = lo_[d] + c * cell_, h = l + cell_;
-      return v < l ? l - v : (v > h ? v - h : 0.0);
-    };
-    int* runs = room.data() + run_start_[i];
-    int count = 0;
-    const int z0 = std::max(0, cell_index(zi - ri, 2)), z1 = std::min(nz - 1, cell_index(zi + ri, 2));
-    const int y0 = std::max(0, cell_index(yi - ri, 1)), y1 = std::min(ny - 1, cell_index(yi + ri, 1));
-    for (int cz = z0; cz <= z1; ++cz) {
-      const double gz = gap(zi, 2, cz);
-      for (int cy = y0; cy <= y1; ++cy) {
-        const double gy = gap(yi, 1, cy);
-        const double rest = r2 - gz * gz - gy * gy;
-        if (rest < 0) continue;
-        // The cells of this row within the ball: one contiguous run of points.
-        const double rx = std::sqrt(rest);
-        const int x0 = std::max(0, cell_index(xi - rx, 0)), x1 = std::min(nx - 1, cell_index(xi + rx, 0));
-        if (x0 > x1) continue;
-        const int base = (cz * ny + cy) * nx;
-        const int k0 = cell_start[base + x0], k1 = cell_start[base + x1 + 1];
-        if (k0 == k1) continue;
-        if (count > 0 && runs[count - 1] == k0) {
-          runs[count - 1] = k1;  // continues the previous run
-        } else {
-          runs[count++] = k0;
-          runs[count++] = k1;
+  std::vector<std::vector<int>> parts(omp_get_max_threads());
+#pragma omp parallel
+  {
+    const int threads = omp_get_num_threads(), t = omp_get_thread_num();
+    const int i_begin = static_cast<int>(static_cast<long>(n_) * t / threads);
+    const int i_end = static_cast<int>(static_cast<long>(n_) * (t + 1) / threads);
+    std::vector<int>& runs = parts[t];
+    runs.reserve(static_cast<std::size_t>(i_end - i_begin) * 48);
+    for (int i = i_begin; i < i_end; ++i) {
+      const double xi = qx_[i], yi = qy_[i], zi = qz_[i];
+      const double r2 = r[i] * r[i], ri = r[i];
+      // Distance from v to the interval of cell c along axis d.
+      auto gap = [&](double v, int d, int c) {
+        const double l = lo_[d] + c * cell_[d], h = l + cell_[d];
+        return v < l ? l - v : (v > h ? v - h : 0.0);
+      };
+      const std::size_t first = runs.size();
+      const int z0 = std::max(0, cell_index(zi - ri, 2)), z1 = std::min(nz - 1, cell_index(zi + ri, 2));
+      const int y0 = std::max(0, cell_index(yi - ri, 1)), y1 = std::min(ny - 1, cell_index(yi + ri, 1));
+      for (int cz = z0; cz <= z1; ++cz) {
+        const double gz = gap(zi, 2, cz);
+        for (int cy = y0; cy <= y1; ++cy) {
+          const double gy = gap(yi, 1, cy);
+          const double rest = r2 - gz * gz - gy * gy;
+          if (rest < 0) continue;
+          // The cells of this row within the ball: one contiguous run of points.
+          const double rx = std::sqrt(rest);
+          const int x0 = std::max(0, cell_index(xi - rx, 0)), x1 = std::min(nx - 1, cell_index(xi + rx, 0));
+          if (x0 > x1) continue;
+          const int base = (cz * ny + cy) * nx;
+          const int k0 = cell_start[base + x0], k1 = cell_start[base + x1 + 1];
+          if (k0 == k1) continue;
+          if (runs.size() > first && runs.back() == k0) {
+            runs.back() = k1;  // continues the previous run
+          } else {
+            runs.push_back(k0);
+            runs.push_back(k1);
+          }
         }
       }
+      run_start_[i + 1] = static_cast<int>(runs.size() - first);
     }
-    used[i] = count;
   }
-  // Compacted: vertex i's runs at [run_start_[i], run_start_[i + 1]).
-  runs_.resize(std::accumulate(used.begin(), used.end(), std::size_t{0}));
-  std::size_t next = 0;
-  for (int i = 0; i < n_; ++i) {
-    const int* from = room.data() + run_start_[i];
-    run_start_[i] = static_cast<int>(next);
-    std::copy(from, from + used[i], runs_.begin() + next);
-    next += used[i];
+  // Joined: vertex i's runs at [run_start_[i], run_start_[i + 1]).
+  for (int i = 0; i < n_; ++i) run_start_[i + 1] += run_start_[i];
+  if (parts.size() == 1) {
+    runs_ = std::move(parts[0]);
+  } else {
+    runs_.clear();
+    runs_.reserve(run_start_[n_]);
+    for (const std::vector<int>& part : parts) runs_.insert(runs_.end(), part.begin(), part.end());
   }
-  run_start_[n_] = static_cast<int>(next);
   run_shared_ = false;
 }
 
-// Both forms through one kernel loop (run_sum_body): for every vertex i, the sum of eq. (13) over
-// the points of its runs (the reference: all points in one run).
+// The reference form (run_sum_body): for every vertex i, the sum of eq. (13) over all points.
 template <int Cols>
 void BelkinLaplacian::apply_columns(const double* const* w, double* const* out) const {
   // The fields in the points' (scan) order, so that a run reads contiguous memory.
@@ -281,7 +403,8 @@ void BelkinLaplacian::apply_columns(const double* const* w, double* const* out) 
   for (int col = 0; col < Cols; ++col)
     for (int k = 0; k < n_; ++k) ws[col * stride + k] = w[col][order_[k]];
   KernelInput in{};
-  in.sx = sx_.data(), in.sy = sy_.data(), in.sz = sz_.data(), in.sn = snorm_.data(), in.sl = slump_.data();
+  in.sx = point_array(0), in.sy = point_array(1), in.sz = point_array(2), in.sn = point_array(3);
+  in.sl = point_array(4);
   for (int col = 0; col < 3; ++col) in.w[col] = ws.data() + (col < Cols ? col : 0) * stride;
   in.emax = max_exponent_;
   in.half_space = options_.half_space;
@@ -303,13 +426,46 @@ void BelkinLaplacian::apply_columns(const double* const* w, double* const* out) 
   }
 }
 
+// The grid form (grid_sum_body): w a scalar field (out[0]), or null for Lap x (out[0..2]).
+void BelkinLaplacian::apply_grid(const double* w, double* const* out) const {
+  // The field in the points' (scan) order, 64-byte aligned, padded by zeros.
+  std::vector<double> buffer(w ? n_ + kLanes + 8 : 0, 0.0);
+  double* ws = w ? aligned64(buffer.data()) : nullptr;
+  for (int k = 0; w && k < n_; ++k) ws[k] = w[order_[k]];
+  GridInput in{};
+  in.sx = point_array(0), in.sy = point_array(1), in.sz = point_array(2), in.sn = point_array(3);
+  in.sl = point_array(4), in.w = ws;
+  constexpr double log2e = 1.4426950408889634074;
+  in.ymax = max_exponent_ * log2e;
+#pragma omp parallel for schedule(dynamic, 64) firstprivate(in)
+  for (int i = 0; i < n_; ++i) {
+    in.xi = qx_[i], in.yi = qy_[i], in.zi = qz_[i];
+    in.margin = kPlaneTolerance * qnorm_[i];
+    const double a = kernel_area_[i];
+    in.scale = log2e / (4.0 * a);
+    in.wi = w ? w[i] : 0.0;
+    double acc[3] = {0, 0, 0};
+    const int* runs = runs_.data() + run_start_[i];
+    const int nruns = (run_start_[i + 1] - run_start_[i]) / 2;
+    if (w)
+      (plane_test_[i] ? grid_sum_scalar_plane : grid_sum_scalar)(in, runs, nruns, acc);
+    else
+      (plane_test_[i] ? grid_sum_positions_plane : grid_sum_positions)(in, runs, nruns, acc);
+    const double scale = 1.0 / (4.0 * M_PI * a * a);  // eq. (13) prefactor
+    for (int col = 0; col < (w ? 1 : 3); ++col) out[col][i] = scale * acc[col];
+  }
+}
+
 Scalars BelkinLaplacian::apply(const Scalars& w) const {
   if (w.size() != n_) throw Error("belkin_laplacian: field has " + std::to_string(w.size()) + " values, mesh has " +
                                   std::to_string(n_) + " vertices");
   Scalars out(n_);
   const double* in[1] = {w.data()};
   double* res[1] = {out.data()};
-  apply_columns<1>(in, res);
+  if (run_shared_)
+    apply_columns<1>(in, res);
+  else
+    apply_grid(w.data(), res);
   return out;
 }
 
@@ -321,7 +477,23 @@ Points BelkinLaplacian::apply(const Points& w) const {
   Eigen::MatrixXd oc(n_, 3);
   const double* in[3] = {wc.col(0).data(), wc.col(1).data(), wc.col(2).data()};
   double* res[3] = {oc.col(0).data(), oc.col(1).data(), oc.col(2).data()};
-  apply_columns<3>(in, res);
+  if (run_shared_) {
+    apply_columns<3>(in, res);
+  } else {
+    for (int col = 0; col < 3; ++col) apply_grid(in[col], res + col);
+  }
+  return oc;
+}
+
+Points BelkinLaplacian::apply_to_positions() const {
+  if (run_shared_) {
+    Points q(n_, 3);
+    for (int p = 0; p < n_; ++p) q.row(p) = Eigen::RowVector3d(qx_[p], qy_[p], qz_[p]);
+    return apply(q);
+  }
+  Eigen::MatrixXd oc(n_, 3);
+  double* res[3] = {oc.col(0).data(), oc.col(1).data(), oc.col(2).data()};
+  apply_grid(nullptr, res);
   return oc;
 }
 
@@ -363,7 +535,8 @@ BendingResult BelkinMethod::compute(const Topology& topology, const Points& x, d
   const MeshGeometry g = MeshGeometry::compute(topology, x);
   const BelkinLaplacian lap(topology, x, g, options_);
   // eq. (2) with eq. (13): Lap x = -2 H n.
-  const Points lap_x = lap.apply(x);
+  // The reference applies the operator to x itself (the grid form: to x - c, the same up to rounding).
+  const Points lap_x = options_.neighbours == BelkinOptions::Neighbours::all ? lap.apply(x) : lap.apply_to_positions();
   Scalars H(topology.num_vertices());
   for (int i = 0; i < topology.num_vertices(); ++i) H[i] = -0.5 * lap_x.row(i).dot(g.normal_mwa.row(i));
   Scalars lapH = lap.apply(H);  // eq. (13) applied to H

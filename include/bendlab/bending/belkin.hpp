@@ -23,32 +23,52 @@
 // - grid (the default, O(N)): terms whose kernel weight exp(-|p - x_i|^2 / (4 a_i)) is below
 //   kernel_cutoff (method option "kernel_cutoff", default 1e-15) are dropped, so vertex i only
 //   sees the points within r_i = sqrt(4 a_i ln(1 / kernel_cutoff)), found through a uniform grid
-//   of cells (a cell list sorted by cell, cells of half the median r_i). With a_i ~ A_total / N the
+//   of cells (a cell list sorted by cell; cell sizes below). With a_i ~ A_total / N the
 //   ball holds about 4 pi ln(1/cutoff) vertices (about 430 at the default) whatever N: O(N).
 //   The neighbour lists (for each vertex, the runs of cell-sorted points, one per row of cells
-//   meeting its ball) are built once per shape, when the operator is constructed, and serve every
-//   apply() (Method D applies it to x and to H).
+//   meeting its ball; cells 0.35 median r_i across the rows and half that along them) are built
+//   once per shape, when the operator is constructed, and serve every apply() (Method D applies
+//   it to x, apply_to_positions(), and to H).
 //   Truncation error: each of the at most N dropped terms has weight A_p * exp(-exponent) <=
 //   A_p * cutoff and |w(p) - w(x_i)| <= 2 max|w|, so (Lap w)_i changes by at most
 //       cutoff * (sum of the dropped A_p) * 2 max|w| / (4 pi a_i^2)
 //     <= cutoff * A_total * 2 max|w| / (4 pi a_i^2)  ~  cutoff * N * max|w| / (2 pi a_i)
 //   (A_total / a_i ~ N); for the 5120-triangle red blood cell (A_total = 8.76, a_i >= 1.3e-3)
 //   that is at most 1e-15 * 8.76 * 2 / (4 pi 1.8e-6) ~ 8e-10 max|w|, against max|Lap x| =
-//   2 max|H| = 4.4. In practice far less (the dropped weights decay like a Gaussian beyond r_i):
-//   measured max-norm differences from the reference, relative, for Method D's f on the red
-//   blood cell: 3e-14 (1280 triangles), 3e-13 (5120), 1.3e-12 (20480), 7.5e-12 (81920); with
-//   cutoff 1e-12 they are 3e-11, 1.6e-10, 7e-10, 5.9e-9 (bench/belkin_neighbours).
+//   2 max|H| = 4.4. In practice far less (the dropped weights decay like a Gaussian beyond r_i).
+//   Measured max-norm differences from the reference, relative, for Method D's f on the red blood
+//   cell (bench/belkin_neighbours TRIANGLES): 3e-14 (1280 triangles), 2.9e-13 (5120), 1.7e-12
+//   (20480), 1.8e-11 (81920); H within 1.1e-13 at every size. (The cut-off alone, with the
+//   reference's exponential: 7.5e-12 at 81920; with cutoff 1e-12: 5.9e-9, too close to 1e-8.)
 //   Values below e^-80 are clamped to e^-80, the reference's own cut, so that both forms keep the
-//   same terms and differ only by the order of the sum.
-// Both forms run one kernel loop (belkin.cpp): over blocks of points of a run, branch-free, the
-// exponent, the half-space and cut-off tests as a 0/1 factor and the exponential by a polynomial
-// (within an ulp of exp, measured over [0, 80]), so that it vectorises (AVX-512, AVX2 or
-// baseline, chosen at run time). One Method D evaluation on the red blood cell, one thread, best
-// of several, processor time on the shared 2-core machine (bench/belkin_neighbours scaling):
-// 81920 triangles 0.105 to 0.14 s against Method C's 0.009 to 0.013 s (12 to 16 times C; the
-// all-pairs reference 4.6 s); 3.6 to 4.5 us per vertex from 5120 to 81920 triangles (linear).
-// The same build before the lists were kept and the loop vectorised: 0.55 to 0.60 s (62 times C).
-// Both are deterministic; they differ only by the order of the sum and the dropped terms.
+//   same terms and differ only by the order of the sum and the exponential below.
+// Kernels (belkin.cpp), branch-free over blocks of points of a run (the exponent, the cut-off,
+// the run's end and the half-space test as a mask) so that they vectorise (AVX-512, AVX2 or
+// baseline, chosen at run time):
+// - all: blocks of 16, exp by a polynomial within an ulp of std::exp (measured over [0, 80]).
+// - grid: blocks of 8 (one AVX-512 register; the runs are short), the exponential in base 2 by a
+//   polynomial of degree 9 (relative error within 2.3e-14), the half-space test only for vertices
+//   whose ball crosses the plane (elsewhere every point of the ball passes it: the same terms),
+//   and for Lap x the differences p - x_i the distance is made of.
+// One Method D evaluation on the red blood cell, one thread, processor time on the shared 2-core
+// machine, best of three, D and C timed in turn, with glibc keeping freed memory:
+//   MALLOC_TRIM_THRESHOLD_=4000000000 MALLOC_MMAP_THRESHOLD_=4000000000 OMP_NUM_THREADS=1
+//   build/release/belkin_neighbours scaling   (one command line)
+// 5120 / 20480 / 81920 triangles: D 0.0039 / 0.0155 / 0.063-0.070 s (1.5-1.7 us per vertex,
+// linear), C 0.0004 / 0.0020-0.0024 / 0.0087-0.0099 s: D / C 8.8-9.5 / 6.4-7.6 / 7.0-7.4. The
+// previous kernel (cubic cells, one kernel for both forms), same command, same time: D 0.110-0.115
+// s, 10.4-10.9 times C; before the lists were kept and the loop vectorised: 0.55 to 0.60 s. The
+// all-pairs reference: 3.8 s. bench_bending's BM_Forces (repeated evaluations, processor time)
+// agrees: D / C 10 / 9.0 / 7.1 (3.97 / 15.6 / 67.0 ms against 0.39 / 1.73 / 9.49 ms). The parts of
+// D at 81920 triangles (belkin_neighbours stages 81920, memory kept): mesh geometry 0.008 s (as
+// C's), set-up 0.013 s, Lap x 0.022 s, Lap H 0.020 s.
+// Without the two variables the same run is not a measure of D: first touch of fresh memory costs
+// 17 us per 4 KiB page on that virtual machine, and what glibc hands back between evaluations
+// depends on what the other method freed. Measured there: with this code C 0.041-0.060 s after D
+// (D 0.122-0.167 s, ratio 2.7-3.0), with the previous code C 0.011-0.016 s (D 0.19-0.23 s, ratio
+// 14-18); the C code is the same.
+// Both are deterministic; they differ only by the order of the sum, the exponential and the
+// dropped terms.
 // The operator of a constant is exactly zero in both (every term carries w(p) - w(x_i) = 0).
 #include <memory>
 #include <vector>
@@ -89,13 +109,20 @@ class BelkinLaplacian {
                   BelkinOptions options = {});
   Scalars apply(const Scalars& w) const;
   Points apply(const Points& w) const;
+  /// Lap x: the operator applied to the positions it was built from (equal to apply(x) up to
+  /// rounding; the grid form reuses the differences p - x_i its kernel computes anyway).
+  Points apply_to_positions() const;
   /// Lumped weight of vertex p: one third of the area of the faces at p.
   const Scalars& lumped_area() const { return lumped_area_; }
 
  private:
   template <int Cols>
   void apply_columns(const double* const* w, double* const* out) const;
+  void apply_grid(const double* w, double* const* out) const;
   void build_grid();
+  /// Array j of the points in scan order (0, 1, 2: centred position; 3: |x_p - c|; 4: lumped
+  /// area), 64-byte aligned, padded by zeros.
+  const double* point_array(int j) const;
 
   BelkinOptions options_;
   int n_ = 0;
@@ -104,16 +131,21 @@ class BelkinLaplacian {
   Scalars lumped_area_;
   Scalars kernel_area_;               ///< a_i = A_mixed_i
   double max_exponent_ = 80;  ///< -ln(kernel_cutoff), at most 80 (the reference: 80)
-  // The grid form: cells of side cell_ from lo_, dims_[0] x dims_[1] x dims_[2], x fastest.
-  double cell_ = 0;
+  // The grid form: cells of sides cell_[0..2] from lo_, dims_[0] x dims_[1] x dims_[2], x fastest.
+  double cell_[3] = {0, 0, 0};
   double lo_[3] = {0, 0, 0};
   int dims_[3] = {1, 1, 1};
   // The points in scan order (grid: sorted by cell; reference: vertex order): order_[k] is the
-  // vertex at position k, s*_ its data. Vertex i scans the runs [runs_[r], runs_[r + 1]) for r in
-  // [run_start_[i], run_start_[i + 1]) step 2 (run_shared_: every vertex the one run runs_[0..1]).
+  // vertex at position k, point_array its data. Vertex i scans the runs [runs_[r], runs_[r + 1])
+  // for r in [run_start_[i], run_start_[i + 1]) step 2 (run_shared_: every vertex the one run
+  // runs_[0..1]).
   std::vector<int> order_, run_start_, runs_;
   bool run_shared_ = false;
-  std::vector<double> sx_, sy_, sz_, snorm_, slump_;
+  std::size_t stride_ = 0;        ///< distance between the point arrays in points_
+  std::vector<double> points_;    ///< the five point arrays (point_array)
+  /// Grid form: 1 where vertex i's ball crosses the half-space plane (the kernel tests each
+  /// point), 0 where every point within its cut-off radius lies above it.
+  std::vector<unsigned char> plane_test_;
 };
 
 /// Method D: normal = MWA; H by eq. (2) with eq. (13) (H = -1/2 (Lap x) . n); lapH by eq. (13)
