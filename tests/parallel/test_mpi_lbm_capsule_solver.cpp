@@ -11,8 +11,8 @@
 #include "bendlab/flow/shear_run.hpp"
 #include "bendlab/membrane/espresso_volume_force.hpp"
 #include "bendlab/mesh/generators.hpp"
-#include "lbm/tiny_capsule.hpp"
 #include "bendlab/parallel/mpi_lbm_capsule_solver.hpp"
+#include "lbm/tiny_capsule.hpp"
 #include "mpi_test_util.hpp"
 
 using namespace bendlab;
