@@ -1,9 +1,6 @@
 #include "bendlab/bending/loop_shell_solve.hpp"
 
-#include <algorithm>
-#include <cmath>
 #include <string>
-#include <vector>
 
 #include "bendlab/core/types.hpp"
 
@@ -53,155 +50,11 @@ void symmetric_product(const Eigen::SparseMatrix<double>& m, const Eigen::Matrix
   }
 }
 
-// Fast path of solve_mass_cg: the columns interleaved row by row (padded to kWidth), so that one pass
-// over M's entries serves every column with contiguous loads; the vector updates fused into two passes
-// per iteration; dot products summed per fixed chunk of rows and then in chunk order, so the
-// iterates do not depend on the thread count.
-constexpr int kChunk = 512;
-
-template <int kWidth>
-Eigen::MatrixXd solve_mass_cg_interleaved(const Eigen::SparseMatrix<double>& m, const Eigen::MatrixXd& b,
-                                          double tolerance, int max_iterations, int* iterations,
-                                          const Eigen::MatrixXd* x0, int parallel_rows) {
-  const int n = static_cast<int>(b.rows());
-  constexpr int k = kWidth;
-  const int chunks = (n + kChunk - 1) / kChunk;
-  const bool parallel = n > parallel_rows;
-  const int* outer = m.outerIndexPtr();
-  const int* inner = m.innerIndexPtr();
-  const double* values = m.valuePtr();
-  std::vector<double> inv_diag(n);
-  {
-    const Eigen::VectorXd d = m.diagonal();
-    for (int i = 0; i < n; ++i) inv_diag[i] = 1.0 / d[i];
-  }
-  const size_t size = static_cast<size_t>(n) * kWidth;
-  std::vector<double> x(size, 0.0), r(size, 0.0), p(size, 0.0), q(size, 0.0);
-  std::vector<double> partial(static_cast<size_t>(chunks) * 2 * kWidth);
-  for (int i = 0; i < n; ++i)
-    for (int c = 0; c < k; ++c) r[i * kWidth + c] = b(i, c);
-  const bool warm = x0 && x0->rows() == n && x0->cols() == k;
-
-  // out = M v, one pass over M (row i of the symmetric M is its column i); with `dot`, the chunks'
-  // partial sums of v.out go to partial (first of the pair; the second is zero).
-  auto product = [&](const std::vector<double>& v, std::vector<double>& out, bool dot) {
-#pragma omp parallel for schedule(static) if (parallel)
-    for (int h = 0; h < chunks; ++h) {
-      double d[kWidth] = {};
-      for (int i = h * kChunk; i < std::min(n, (h + 1) * kChunk); ++i) {
-        double s[kWidth] = {};
-        for (int e = outer[i]; e < outer[i + 1]; ++e) {
-          const double a = values[e];
-          const double* vj = &v[static_cast<size_t>(inner[e]) * kWidth];
-          for (int c = 0; c < kWidth; ++c) s[c] += a * vj[c];
-        }
-        const double* vi = &v[static_cast<size_t>(i) * kWidth];
-        for (int c = 0; c < kWidth; ++c) {
-          out[static_cast<size_t>(i) * kWidth + c] = s[c];
-          d[c] += vi[c] * s[c];
-        }
-      }
-      if (dot)
-        for (int c = 0; c < kWidth; ++c) {
-          partial[(h * 2) * kWidth + c] = d[c];
-          partial[(h * 2 + 1) * kWidth + c] = 0.0;
-        }
-    }
-  };
-  // Sums of per-chunk partials (2 kWidth per chunk) in chunk order.
-  auto reduce = [&](double* first, double* second) {
-    for (int c = 0; c < kWidth; ++c) first[c] = second[c] = 0.0;
-    for (int h = 0; h < chunks; ++h)
-      for (int c = 0; c < kWidth; ++c) {
-        first[c] += partial[(h * 2) * kWidth + c];
-        second[c] += partial[(h * 2 + 1) * kWidth + c];
-      }
-  };
-
-  if (warm) {
-    for (int i = 0; i < n; ++i)
-      for (int c = 0; c < k; ++c) x[i * kWidth + c] = (*x0)(i, c);
-    product(x, q, false);
-    for (size_t e = 0; e < size; ++e) r[e] -= q[e];
-  }
-  double limit[kWidth] = {}, rz[kWidth], res2[kWidth];
-  for (int c = 0; c < k; ++c) limit[c] = tolerance * b.col(c).norm();
-  // p = D^-1 r; rz = r.D^-1 r; res2 = r.r
-#pragma omp parallel for schedule(static) if (parallel)
-  for (int h = 0; h < chunks; ++h) {
-    double s1[kWidth] = {}, s2[kWidth] = {};
-    for (int i = h * kChunk; i < std::min(n, (h + 1) * kChunk); ++i)
-      for (int c = 0; c < kWidth; ++c) {
-        const double ri = r[i * kWidth + c], zi = inv_diag[i] * ri;
-        p[i * kWidth + c] = zi;
-        s1[c] += ri * zi;
-        s2[c] += ri * ri;
-      }
-    for (int c = 0; c < kWidth; ++c) {
-      partial[(h * 2) * kWidth + c] = s1[c];
-      partial[(h * 2 + 1) * kWidth + c] = s2[c];
-    }
-  }
-  reduce(rz, res2);
-  int it = 0;
-  while (true) {
-    double active[kWidth] = {};
-    bool any = false;
-    for (int c = 0; c < k; ++c)
-      if (std::sqrt(res2[c]) > limit[c]) active[c] = 1.0, any = true;
-    if (!any) break;
-    if (it == max_iterations)
-      throw Error("method S: the mass-matrix solve did not converge in " + std::to_string(max_iterations) +
-                  " CG iterations");
-    ++it;
-    // q = M p and p.q
-    double pq[kWidth], unused[kWidth];
-    product(p, q, true);
-    reduce(pq, unused);
-    // Converged columns keep x and r (alpha = 0), as the reference does.
-    double alpha[kWidth] = {};
-    for (int c = 0; c < k; ++c) alpha[c] = active[c] != 0.0 ? rz[c] / pq[c] : 0.0;
-    double rz_new[kWidth];
-#pragma omp parallel for schedule(static) if (parallel)
-    for (int h = 0; h < chunks; ++h) {
-      double s1[kWidth] = {}, s2[kWidth] = {};
-      for (int i = h * kChunk; i < std::min(n, (h + 1) * kChunk); ++i)
-        for (int c = 0; c < kWidth; ++c) {
-          const size_t e = static_cast<size_t>(i) * kWidth + c;
-          x[e] += alpha[c] * p[e];
-          r[e] -= alpha[c] * q[e];
-          const double zi = inv_diag[i] * r[e];
-          s1[c] += r[e] * zi;
-          s2[c] += r[e] * r[e];
-        }
-      for (int c = 0; c < kWidth; ++c) {
-        partial[(h * 2) * kWidth + c] = s1[c];
-        partial[(h * 2 + 1) * kWidth + c] = s2[c];
-      }
-    }
-    reduce(rz_new, res2);
-    double beta[kWidth] = {};
-    for (int c = 0; c < k; ++c) beta[c] = rz[c] > 0 ? rz_new[c] / rz[c] : 0.0;
-#pragma omp parallel for schedule(static) if (parallel)
-    for (int i = 0; i < n; ++i)
-      for (int c = 0; c < kWidth; ++c) {
-        const size_t e = static_cast<size_t>(i) * kWidth + c;
-        p[e] = inv_diag[i] * r[e] + beta[c] * p[e];
-      }
-    for (int c = 0; c < k; ++c) rz[c] = rz_new[c];
-  }
-  if (iterations) *iterations = it;
-  Eigen::MatrixXd out(n, k);
-  for (int i = 0; i < n; ++i)
-    for (int c = 0; c < k; ++c) out(i, c) = x[i * kWidth + c];
-  return out;
-}
-
 }  // namespace
 
-Eigen::MatrixXd solve_mass_cg_reference(const Eigen::SparseMatrix<double>& m, const Eigen::MatrixXd& b,
-                                        double tolerance, int max_iterations, int* iterations,
-                                        const Eigen::MatrixXd* x0, int parallel_rows) {
+Eigen::MatrixXd solve_mass_cg(const Eigen::SparseMatrix<double>& m, const Eigen::MatrixXd& b, double tolerance,
+                              int max_iterations, int* iterations, const Eigen::MatrixXd* x0,
+                              int parallel_rows) {
   const Eigen::Index n = b.rows(), k = b.cols();
   const Eigen::VectorXd inv_diag = m.diagonal().cwiseInverse();
   const bool warm = x0 && x0->rows() == n && x0->cols() == k;
@@ -239,18 +92,6 @@ Eigen::MatrixXd solve_mass_cg_reference(const Eigen::SparseMatrix<double>& m, co
   }
   if (iterations) *iterations = it;
   return x;
-}
-
-Eigen::MatrixXd solve_mass_cg(const Eigen::SparseMatrix<double>& m, const Eigen::MatrixXd& b, double tolerance,
-                              int max_iterations, int* iterations, const Eigen::MatrixXd* x0,
-                              int parallel_rows) {
-  switch (b.cols()) {
-    case 1: return solve_mass_cg_interleaved<1>(m, b, tolerance, max_iterations, iterations, x0, parallel_rows);
-    case 2: return solve_mass_cg_interleaved<2>(m, b, tolerance, max_iterations, iterations, x0, parallel_rows);
-    case 3: return solve_mass_cg_interleaved<3>(m, b, tolerance, max_iterations, iterations, x0, parallel_rows);
-    case 4: return solve_mass_cg_interleaved<4>(m, b, tolerance, max_iterations, iterations, x0, parallel_rows);
-    default: return solve_mass_cg_reference(m, b, tolerance, max_iterations, iterations, x0, parallel_rows);
-  }
 }
 
 }  // namespace bendlab::loop_shell
