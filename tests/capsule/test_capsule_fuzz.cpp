@@ -26,6 +26,7 @@
 #include "bendlab/core/file_input.hpp"
 #include "bendlab/flow/bim/bim_capsule_solver.hpp"
 #include "bendlab/mesh/generators.hpp"
+#include "core/byte_mutation.hpp"
 
 namespace fs = std::filesystem;
 using namespace bendlab;
@@ -64,47 +65,14 @@ RunFiles run_files() {
   return f;
 }
 
-const char* const kTokens[] = {"-1", "0", "1", "2", "-0", "1e308", "-1e308", "1e999", "1e-320", "nan", "inf",
+const std::vector<std::string> kTokens = {"-1", "0", "1", "2", "-0", "1e308", "-1e308", "1e999", "1e-320", "nan", "inf",
                                "-inf", "nan(1)", "0x1p3", "+", "-", ".", "e5", "9223372036854775807",
                                "9223372036854775808", "-9223372036854775809", "18446744073709551616", "\"\"",
                                "\"x\"", "null", "true", "[]", "{}", "[[", "]}", ",", ",,", "\n", "\r\n", " ",
                                "\"../x.vtp\"", "\"snapshot_99999.vtp\"", "\"\\u0000\"", "\"\\ud800\""};
 
-std::string mutate_bytes(const std::string& seed, std::mt19937_64& rng) {
-  std::string s = seed;
-  auto pick = [&](std::size_t n) { return n == 0 ? 0 : static_cast<std::size_t>(rng() % n); };
-  const int mutations = 1 + static_cast<int>(rng() % 4);
-  for (int m = 0; m < mutations; ++m) {
-    switch (rng() % 7) {
-      case 0:  // flip one bit
-        if (!s.empty()) s[pick(s.size())] ^= static_cast<char>(1u << (rng() % 8));
-        break;
-      case 1:  // insert random bytes
-        s.insert(pick(s.size() + 1), std::string(1 + pick(8), static_cast<char>(rng())));
-        break;
-      case 2:  // delete a range
-        s.erase(pick(s.size()), 1 + pick(16));
-        break;
-      case 3: {  // duplicate a range
-        const std::size_t at = pick(s.size()), n = 1 + pick(64);
-        s.insert(pick(s.size() + 1), s.substr(at, n));
-        break;
-      }
-      case 4:  // truncate
-        s.resize(pick(s.size() + 1));
-        break;
-      case 5: {  // replace a token (up to the next separator) by an odd one
-        const std::size_t at = pick(s.size());
-        std::size_t end = s.find_first_of(",:[]{}\n", at);
-        if (end == std::string::npos) end = s.size();
-        s.replace(at, end - at, kTokens[pick(std::size(kTokens))]);
-        break;
-      }
-      default:  // overwrite a byte with a random value
-        if (!s.empty()) s[pick(s.size())] = static_cast<char>(rng());
-    }
-  }
-  return s;
+std::string mutate_file(const std::string& seed, std::mt19937_64& rng) {
+  return test::mutate_bytes(seed, rng, kTokens, ",:[]{}\n");
 }
 
 /// A value of the document replaced by one of another type or range, or removed.
@@ -159,7 +127,7 @@ TEST(CapsuleReaderFuzz, EveryMutatedCheckpointIsAcceptedOrRefusedWithError) {
   std::mt19937_64 rng(20261202);
   Outcome out;
   for (long i = 0; i < n; ++i) {
-    const std::string input = i % 2 == 0 ? mutate_bytes(files.checkpoint, rng) : mutate_structure(seed, rng);
+    const std::string input = i % 2 == 0 ? mutate_file(files.checkpoint, rng) : mutate_structure(seed, rng);
     expect_accepted_or_error(input, source, parse, out, i);
     if (HasFatalFailure()) return;
   }
@@ -178,7 +146,7 @@ TEST(CapsuleReaderFuzz, EveryMutatedTimeSeriesIsAcceptedOrRefusedWithError) {
   std::mt19937_64 rng(20261203);
   Outcome out;
   for (long i = 0; i < n; ++i) {
-    expect_accepted_or_error(mutate_bytes(files.series, rng), source, parse, out, i);
+    expect_accepted_or_error(mutate_file(files.series, rng), source, parse, out, i);
     if (HasFatalFailure()) return;
   }
   EXPECT_GT(out.accepted, 0);

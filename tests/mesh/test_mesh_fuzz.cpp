@@ -19,6 +19,7 @@
 #include "bendlab/core/file_input.hpp"
 #include "bendlab/mesh/generators.hpp"
 #include "bendlab/mesh/mesh_io.hpp"
+#include "core/byte_mutation.hpp"
 
 namespace fs = std::filesystem;
 using namespace bendlab;
@@ -72,49 +73,14 @@ std::vector<Seed> seeds() {
   return out;
 }
 
-const char* const kTokens[] = {"-1", "0", "3", "4", "255", "65536", "2147483647", "-2147483648", "4294967296",
+const std::vector<std::string> kTokens = {"-1", "0", "3", "4", "255", "65536", "2147483647", "-2147483648", "4294967296",
                                "1e308", "-1e308", "1e-320", "nan", "inf", "-inf", "0x10", "+", "-", ".", "e5",
                                "999999999999999999999", "\n", " ", "#", "/", "//", "ply", "end_header",
                                "element face 1000000000\n", "property list uchar int vertex_indices\n",
                                "format binary_little_endian 1.0\n", "property double x\n", "f 1 2\n", "v 1 2\n"};
 
 std::string mutate(const std::string& seed, std::mt19937_64& rng) {
-  std::string s = seed;
-  auto pick = [&](std::size_t n) { return n == 0 ? 0 : static_cast<std::size_t>(rng() % n); };
-  const int mutations = 1 + static_cast<int>(rng() % 4);
-  for (int m = 0; m < mutations; ++m) {
-    switch (rng() % 7) {
-      case 0:  // flip one bit
-        if (!s.empty()) s[pick(s.size())] ^= static_cast<char>(1u << (rng() % 8));
-        break;
-      case 1:  // insert random bytes
-        s.insert(pick(s.size() + 1), std::string(1 + pick(8), static_cast<char>(rng())));
-        break;
-      case 2: {  // delete a range
-        const std::size_t at = pick(s.size()), n = 1 + pick(16);
-        s.erase(at, n);
-        break;
-      }
-      case 3: {  // duplicate a range
-        const std::size_t at = pick(s.size()), n = 1 + pick(64);
-        s.insert(pick(s.size() + 1), s.substr(at, n));
-        break;
-      }
-      case 4:  // truncate
-        s.resize(pick(s.size() + 1));
-        break;
-      case 5: {  // replace a token (up to the next space or newline) by an odd one
-        const std::size_t at = pick(s.size());
-        std::size_t end = s.find_first_of(" \n", at);
-        if (end == std::string::npos) end = s.size();
-        s.replace(at, end - at, kTokens[pick(std::size(kTokens))]);
-        break;
-      }
-      default:  // overwrite a byte with a random value
-        if (!s.empty()) s[pick(s.size())] = static_cast<char>(rng());
-    }
-  }
-  return s;
+  return test::mutate_bytes(seed, rng, kTokens, " \n");
 }
 
 }  // namespace
