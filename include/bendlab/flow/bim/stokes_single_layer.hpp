@@ -51,8 +51,9 @@
 namespace bendlab {
 
 /// all7: the 7-point rule on every non-singular triangle for every target (the reference, default);
-/// adaptive: the 7-point rule near the target, the moment-corrected centroid rule far from it.
-enum class SingleLayerQuadrature { all7, adaptive };
+/// adaptive: the 7-point rule near the target, the moment-corrected centroid rule far from it;
+/// tree: the 7-point rule near the target, Chebyshev proxy grids of a cluster tree far from it.
+enum class SingleLayerQuadrature { all7, adaptive, tree };
 
 struct SingleLayerOptions {
   int angular_points = 8;        ///< Gauss-Legendre points per sub-angle of a singular triangle
@@ -61,9 +62,13 @@ struct SingleLayerOptions {
   int cluster_size = 32;   ///< adaptive: triangles per cluster (>= 1)
   int far_order = 1;       ///< adaptive: the far rule matches the cluster's moments up to this degree (0..4)
   double far_ratio = 4.0;  ///< adaptive: far when |x_i - c_c| >= far_ratio * rho_c (> 1)
+  int tree_leaf_size = 16;  ///< tree: at most this many triangles per leaf cluster (>= 1)
+  int tree_order = 7;       ///< tree: the proxies interpolate the kernel to this total degree (0..8)
+  double tree_ratio = 1.5;  ///< tree: far only when |x_i - c_j| >= tree_ratio * rho_j (> 1)
+  double tree_tolerance = 2e-6;  ///< tree: and when the far field's error estimate is below this (>= 0)
 };
 
-/// "all7" | "adaptive"; the inverse throws bendlab::Error naming the unknown value.
+/// "all7" | "adaptive" | "tree"; the inverse throws bendlab::Error naming the unknown value.
 std::string to_string(SingleLayerQuadrature q);
 SingleLayerQuadrature single_layer_quadrature(const std::string& name);
 
@@ -80,6 +85,7 @@ class StokesSingleLayer {
 
  private:
   void prepare(const Points& x, const Points& f) const;
+  void prepare_tree(const Points& x) const;
 
   TopologyPtr topology_;
   SingleLayerOptions options_;
@@ -94,6 +100,18 @@ class StokesSingleLayer {
   // squared times far_ratio^2, and whether the far rule may be used.
   mutable std::vector<double> px_, py_, pz_, pfx_, pfy_, pfz_;
   mutable std::vector<double> cx_, cy_, cz_, far2_;
+  // tree: clusters in breadth-first order (the root first; the children of a cluster are
+  // consecutive), each the range [tree_begin_, tree_end_) of sorted faces, its first child (-1: a
+  // leaf), its proxy slot (-1: none) and the first cluster of each depth. Built once.
+  std::vector<int> tree_begin_, tree_end_, tree_child_, tree_proxy_, tree_level_;
+  // Degrees (a, b, c) of the Chebyshev basis, reference proxies in [-1, 1]^3 (x, y, z each) and
+  // the Lagrange basis at them in the Chebyshev basis (C(beta, m) at beta * count + m).
+  std::vector<int> tree_basis_;
+  std::vector<double> tree_reference_, tree_lagrange_;
+  // Per evaluation: box centres, far distance squared, proxy counts (0: none) and the proxies.
+  mutable std::vector<int> tree_count_;
+  mutable std::vector<double> bcx_, bcy_, bcz_, tree_far2_;
+  mutable std::vector<double> tpx_, tpy_, tpz_, tfx_, tfy_, tfz_;
 };
 
 /// The 7-point degree-5 rule on a triangle: barycentric coordinates (of corners 0, 1, 2) and
