@@ -32,6 +32,39 @@
 //   the gain is 1.2 times at most: with a cluster's far zone beginning 6 to 10 radii away, most of
 //   a 5120-triangle capsule is near every cluster, and the 7-point rule dominates. The adaptive rule
 //   therefore is not the default (a hierarchical, treecode-like far field would be needed).
+//   (tree) a hierarchical far field:
+//     * clusters: a binary tree over the faces, halving each range until it holds at most
+//       `tree_leaf_size` faces; per evaluation the faces are sorted by Morton key and then split
+//       top down at the median centroid along the widest extent of the cluster's centroids (a k-d
+//       tree: compact clusters whatever the shape). Cluster j has a box along the principal axes
+//       of its triangle corners, centre c_j, half widths h_j, radius rho_j = |h_j|;
+//     * far field of a cluster: the kernel G(y, x) is interpolated in y over the box by a
+//       polynomial of total degree q = `tree_order` in the Chebyshev basis T_a T_b T_c (a + b + c
+//       <= q), at m = (q + 1)(q + 2)(q + 3)/6 proxy points (approximate Fekete points picked once
+//       by column-pivoted QR from a tensor Chebyshev grid in [-1, 1]^3, mapped to the box; 120 for
+//       q = 7). Proxy weights W_m = sum_k L_m(y_k) w_k f_k (L_m the Lagrange basis at the proxies)
+//       come from the Chebyshev moments of the cluster's 7-point points (leaves) or of its
+//       children's proxies, which carry their moments of degree <= q exactly (a polynomial of
+//       degree <= q in the parent's box is one in the child's), so each level costs O(m^2);
+//       clusters whose proxies would be more than half their 7-point points keep those points;
+//     * a node x_i uses cluster j's proxies when |x_i - c_j| >= d_j, d_j = max(tree_ratio rho_j,
+//       (A_j rho_j^(q+1) / (tau U))^(1/(q+2))), A_j = sum |w_k f_k| over the cluster, U = sum |w_k f_k|
+//       over the surface / (half diagonal of its bounding box), tau = `tree_tolerance`; else it
+//       descends, and near leaves sum the 7-point rule (consecutive ranges in one call). The Taylor
+//       remainder of G about c_j bounds the interpolation error of a cluster's contribution by
+//       about A_j (rho_j / d)^(q+1) / d times the Lebesgue constant of the proxies, so the
+//       acceptance keeps each accepted cluster's error below about tau U, at most tree_ratio
+//       (> 1) box radii away, which keeps every node off the far field of its own triangles.
+//   Measured (tests/flow/test_stokes_single_layer.cpp; bench: ./build/release/bench_bim
+//   --benchmark_filter='BM_QuadratureRatio/.*_tree/triangles:5120/' --benchmark_min_time=1.5) with
+//   the defaults (16, 7, 1.5, 2e-6), max_i |u_tree - u_all7| / max_i |u_all7|: 1.1e-6 (red blood
+//   cell) and 2.4e-7 (ellipsoid) at 1280 triangles, 2.2e-6 and 4.4e-7 at 5120, where one evaluation
+//   is 1.25 (red blood cell) and 1.47 (ellipsoid) times faster than all7 on one thread (wall
+//   clock on a shared 2-core machine; on two threads there the ratios, 0.6 and 1.1, were
+//   dominated by other load). Per node about 8500 7-point and 6100 proxy points are summed
+//   instead of 35840, so the sums alone would be 2.4 times faster; the rest is the set-up
+//   (moments about 12 %, boxes 5 %), the traversal and the polar integrals (together about 20 %).
+//   The 3x target at 1e-5 is not reached at 5120 triangles; the rule is not the default.
 //   Every cluster that contains a corner at x_i lies within rho_c of x_i, so far_ratio > 1 keeps
 //   the triangles at x_i on the 7-point rule, which the singular correction below takes back.
 // - Triangles that contain x_i: polar coordinates (rho, phi) centred on x_i [118]. There
@@ -52,7 +85,7 @@ namespace bendlab {
 
 /// all7: the 7-point rule on every non-singular triangle for every target (the reference, default);
 /// adaptive: the 7-point rule near the target, the moment-corrected centroid rule far from it;
-/// tree: the 7-point rule near the target, Chebyshev proxy grids of a cluster tree far from it.
+/// tree: the 7-point rule near the target, Chebyshev proxies of a cluster tree far from it.
 enum class SingleLayerQuadrature { all7, adaptive, tree };
 
 struct SingleLayerOptions {
