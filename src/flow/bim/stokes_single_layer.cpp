@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <numeric>
 #include <utility>
@@ -464,104 +465,113 @@ void StokesSingleLayer::prepare_tree(const Points& x) const {
   for (std::size_t k = 0; k < nq; ++k) total += std::sqrt(fx_[k] * fx_[k] + fy_[k] * fy_[k] + fz_[k] * fz_[k]);
   const double span = 0.5 * (x.colwise().maxCoeff() - x.colwise().minCoeff()).norm();
   const double budget = options_.tree_tolerance * total / span;
-  for (int level = levels - 1; level >= 0; --level) {  // children before parents
-#pragma omp parallel for schedule(dynamic, 1)
-    for (int j = tree_level_[level]; j < tree_level_[level + 1]; ++j) {
-      const int b = tree_begin_[j], e = tree_end_[j];
-      // The box of the cluster's triangle corners along their principal axes: it holds every
-      // 7-point point and every proxy of the cluster, and every node on its triangles.
-      Vec3 mean = Vec3::Zero();
-      for (int k = b; k < e; ++k)
-        for (int d = 0; d < 3; ++d) mean += row(x, F(slot_[k], d));
-      mean /= 3.0 * (e - b);
-      Mat3 cov = Mat3::Zero();
-      for (int k = b; k < e; ++k)
-        for (int d = 0; d < 3; ++d) {
-          const Vec3 r = row(x, F(slot_[k], d)) - mean;
-          cov += r * r.transpose();
-        }
-      Mat3 R = Mat3::Identity();
-      if (cov.allFinite()) {
-        const Eigen::SelfAdjointEigenSolver<Mat3> es(cov);
-        if (es.info() == Eigen::Success) R = es.eigenvectors();
+  auto process = [&](int j) {  // box, acceptance distance and proxies of cluster j, its children done
+    const int b = tree_begin_[j], e = tree_end_[j];
+    // The box of the cluster's triangle corners along their principal axes: it holds every
+    // 7-point point and every proxy of the cluster, and every node on its triangles.
+    Vec3 mean = Vec3::Zero();
+    for (int k = b; k < e; ++k)
+      for (int d = 0; d < 3; ++d) mean += row(x, F(slot_[k], d));
+    mean /= 3.0 * (e - b);
+    Mat3 cov = Mat3::Zero();
+    for (int k = b; k < e; ++k)
+      for (int d = 0; d < 3; ++d) {
+        const Vec3 r = row(x, F(slot_[k], d)) - mean;
+        cov += r * r.transpose();
       }
-      Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
-      for (int k = b; k < e; ++k)
-        for (int d = 0; d < 3; ++d) {
-          const Vec3 s = R.transpose() * (row(x, F(slot_[k], d)) - mean);
-          lo = lo.cwiseMin(s);
-          hi = hi.cwiseMax(s);
-        }
-      const Vec3 centre = mean + R * (0.5 * (lo + hi)), h = 0.5 * (hi - lo);
-      bcx_[j] = centre.x(); bcy_[j] = centre.y(); bcz_[j] = centre.z();
-      const double rho2 = h.squaredNorm();
-      // A point-like or non-finite box is never far (its faces keep the 7-point rule).
-      const bool usable = rho2 > 0 && std::isfinite(rho2);
-      // Far: at least tree_ratio box half diagonals away, and where the far field's error estimate
-      // A_j (rho / d)^(q + 1) / d (A_j = sum |F_k| over the cluster) is below the budget.
-      double a = 0;
-      if (tree_child_[j] < 0) {
-        for (std::size_t k = 7 * static_cast<std::size_t>(b); k < 7 * static_cast<std::size_t>(e); ++k)
-          a += std::sqrt(fx_[k] * fx_[k] + fy_[k] * fy_[k] + fz_[k] * fz_[k]);
-      } else {
-        a = strength[tree_child_[j]] + strength[tree_child_[j] + 1];
-      }
-      strength[j] = a;
-      double dmin = ratio * std::sqrt(rho2);
-      if (budget > 0) dmin = std::max(dmin, std::pow(a * std::pow(rho2, 0.5 * (q + 1)) / budget, 1.0 / (q + 2)));
-      tree_far2_[j] = usable ? dmin * dmin : std::numeric_limits<double>::infinity();
-      tree_count_[j] = 0;
-      // Proxies only where they are at most half as many as the 7-point points; elsewhere the
-      // exact rule costs little more.
-      if (!usable || tree_proxy_[j] < 0 || 2 * padded > 7 * (e - b)) continue;
-      tree_count_[j] = padded;
-      // Chebyshev moments M_beta = sum_k T_beta(s_k) F_k, |beta| <= q, of the cluster's sources
-      // k, s_k their coordinates in the box scaled to [-1, 1]^3: the 7-point points of a leaf or
-      // of a child without proxies, and the proxies of a child with them (they carry the child's
-      // moments of degree <= q exactly, and a polynomial of degree <= q in the parent's box is
-      // one in the child's).
-      Vec3 inv_h;
-      for (int d = 0; d < 3; ++d) inv_h[d] = h[d] > 1e-12 * std::sqrt(rho2) ? 1.0 / h[d] : 0.0;
-      const Mat3 S = inv_h.asDiagonal() * R.transpose();
-      double M[3][165] = {};
-      auto add = [&](const double* sx, const double* sy, const double* sz, const double* sfx, const double* sfy,
-                     const double* sfz, int count) {
-        chebyshev_moments(S.data(), centre.data(), q, sx, sy, sz, sfx, sfy, sfz, count, M[0], M[1], M[2]);
-      };
-      auto add_points = [&](int kb, int ke) {
-        const std::size_t o = 7 * static_cast<std::size_t>(kb);
-        add(qx_.data() + o, qy_.data() + o, qz_.data() + o, fx_.data() + o, fy_.data() + o, fz_.data() + o,
-            7 * (ke - kb));
-      };
-      const int child = tree_child_[j];
-      if (child < 0) {
-        add_points(b, e);
-      } else {
-        for (int c = child; c < child + 2; ++c) {
-          if (tree_count_[c] == 0) {
-            add_points(tree_begin_[c], tree_end_[c]);
-          } else {
-            const std::size_t o = static_cast<std::size_t>(tree_proxy_[c]) * padded;
-            add(tpx_.data() + o, tpy_.data() + o, tpz_.data() + o, tfx_.data() + o, tfy_.data() + o,
-                tfz_.data() + o, tree_count_[c]);
-          }
-        }
-      }
-      // Proxies: the reference points in the box, weights W_m = sum_beta C(beta, m) M_beta (the
-      // Lagrange basis of degree q at the reference points in the Chebyshev basis); the padding
-      // carries zero weights at the centre.
-      const std::size_t o = static_cast<std::size_t>(tree_proxy_[j]) * padded;
-      const double* C = tree_lagrange_.data();
-      for (int m = 0; m < padded; ++m) {
-        Vec3 p = centre;
-        if (m < nm)
-          p += R * Vec3(h[0] * tree_reference_[3 * m], h[1] * tree_reference_[3 * m + 1],
-                        h[2] * tree_reference_[3 * m + 2]);
-        tpx_[o + m] = p.x(); tpy_[o + m] = p.y(); tpz_[o + m] = p.z();
-      }
-      lagrange_weights(C, M[0], M[1], M[2], nm, padded, tfx_.data() + o, tfy_.data() + o, tfz_.data() + o);
+    Mat3 R = Mat3::Identity();
+    if (cov.allFinite()) {
+      const Eigen::SelfAdjointEigenSolver<Mat3> es(cov);
+      if (es.info() == Eigen::Success) R = es.eigenvectors();
     }
+    Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+    for (int k = b; k < e; ++k)
+      for (int d = 0; d < 3; ++d) {
+        const Vec3 s = R.transpose() * (row(x, F(slot_[k], d)) - mean);
+        lo = lo.cwiseMin(s);
+        hi = hi.cwiseMax(s);
+      }
+    const Vec3 centre = mean + R * (0.5 * (lo + hi)), h = 0.5 * (hi - lo);
+    bcx_[j] = centre.x(); bcy_[j] = centre.y(); bcz_[j] = centre.z();
+    const double rho2 = h.squaredNorm();
+    // A point-like or non-finite box is never far (its faces keep the 7-point rule).
+    const bool usable = rho2 > 0 && std::isfinite(rho2);
+    // Far: at least tree_ratio box half diagonals away, and where the far field's error estimate
+    // A_j (rho / d)^(q + 1) / d (A_j = sum |F_k| over the cluster) is below the budget.
+    double a = 0;
+    if (tree_child_[j] < 0) {
+      for (std::size_t k = 7 * static_cast<std::size_t>(b); k < 7 * static_cast<std::size_t>(e); ++k)
+        a += std::sqrt(fx_[k] * fx_[k] + fy_[k] * fy_[k] + fz_[k] * fz_[k]);
+    } else {
+      a = strength[tree_child_[j]] + strength[tree_child_[j] + 1];
+    }
+    strength[j] = a;
+    double dmin = ratio * std::sqrt(rho2);
+    if (budget > 0) dmin = std::max(dmin, std::pow(a * std::pow(rho2, 0.5 * (q + 1)) / budget, 1.0 / (q + 2)));
+    tree_far2_[j] = usable ? dmin * dmin : std::numeric_limits<double>::infinity();
+    tree_count_[j] = 0;
+    // Proxies only where they are at most half as many as the 7-point points; elsewhere the
+    // exact rule costs little more.
+    if (!usable || tree_proxy_[j] < 0 || 2 * padded > 7 * (e - b)) return;
+    tree_count_[j] = padded;
+    // Chebyshev moments M_beta = sum_k T_beta(s_k) F_k, |beta| <= q, of the cluster's sources
+    // k, s_k their coordinates in the box scaled to [-1, 1]^3: the 7-point points of a leaf or
+    // of a child without proxies, and the proxies of a child with them (they carry the child's
+    // moments of degree <= q exactly, and a polynomial of degree <= q in the parent's box is
+    // one in the child's).
+    Vec3 inv_h;
+    for (int d = 0; d < 3; ++d) inv_h[d] = h[d] > 1e-12 * std::sqrt(rho2) ? 1.0 / h[d] : 0.0;
+    const Mat3 S = inv_h.asDiagonal() * R.transpose();
+    double M[3][165] = {};
+    auto add = [&](const double* sx, const double* sy, const double* sz, const double* sfx, const double* sfy,
+                   const double* sfz, int count) {
+      chebyshev_moments(S.data(), centre.data(), q, sx, sy, sz, sfx, sfy, sfz, count, M[0], M[1], M[2]);
+    };
+    auto add_points = [&](int kb, int ke) {
+      const std::size_t o = 7 * static_cast<std::size_t>(kb);
+      add(qx_.data() + o, qy_.data() + o, qz_.data() + o, fx_.data() + o, fy_.data() + o, fz_.data() + o,
+          7 * (ke - kb));
+    };
+    const int child = tree_child_[j];
+    if (child < 0) {
+      add_points(b, e);
+    } else {
+      for (int c = child; c < child + 2; ++c) {
+        if (tree_count_[c] == 0) {
+          add_points(tree_begin_[c], tree_end_[c]);
+        } else {
+          const std::size_t o = static_cast<std::size_t>(tree_proxy_[c]) * padded;
+          add(tpx_.data() + o, tpy_.data() + o, tpz_.data() + o, tfx_.data() + o, tfy_.data() + o,
+              tfz_.data() + o, tree_count_[c]);
+        }
+      }
+    }
+    // Proxies: the reference points in the box, weights W_m = sum_beta C(beta, m) M_beta (the
+    // Lagrange basis of degree q at the reference points in the Chebyshev basis); the padding
+    // carries zero weights at the centre.
+    const std::size_t o = static_cast<std::size_t>(tree_proxy_[j]) * padded;
+    const double* C = tree_lagrange_.data();
+    for (int m = 0; m < padded; ++m) {
+      Vec3 p = centre;
+      if (m < nm)
+        p += R * Vec3(h[0] * tree_reference_[3 * m], h[1] * tree_reference_[3 * m + 1],
+                      h[2] * tree_reference_[3 * m + 2]);
+      tpx_[o + m] = p.x(); tpy_[o + m] = p.y(); tpz_[o + m] = p.z();
+    }
+    lagrange_weights(C, M[0], M[1], M[2], nm, padded, tfx_.data() + o, tfy_.data() + o, tfz_.data() + o);
+  };
+  // Children before parents, in one parallel region: the subtrees below depth `split` each on one
+  // thread (bottom up, that is in decreasing breadth-first index), then the top levels in order.
+  const int split = std::min(levels - 1, 5);
+#pragma omp parallel for schedule(dynamic, 1)
+  for (int r = tree_level_[split]; r < tree_level_[split + 1]; ++r) {
+    std::vector<int> nodes{r};
+    for (std::size_t k = 0; k < nodes.size(); ++k)
+      if (tree_child_[nodes[k]] >= 0) nodes.insert(nodes.end(), {tree_child_[nodes[k]], tree_child_[nodes[k]] + 1});
+    std::sort(nodes.begin(), nodes.end(), std::greater<int>());
+    for (const int j : nodes) process(j);
   }
+  for (int j = tree_level_[split] - 1; j >= 0; --j) process(j);
 }
 
 void StokesSingleLayer::velocity(const Points& x, const Points& f, double mu, Points& u) const {
