@@ -56,15 +56,15 @@
 //       acceptance keeps each accepted cluster's error below about tau U, at most tree_ratio
 //       (> 1) box radii away, which keeps every node off the far field of its own triangles.
 //   Measured (tests/flow/test_stokes_single_layer.cpp; bench: ./build/release/bench_bim
-//   --benchmark_filter='BM_QuadratureRatio/.*_tree/triangles:5120/' --benchmark_min_time=1.5) with
-//   the defaults (16, 7, 1.5, 2e-6), max_i |u_tree - u_all7| / max_i |u_all7|: 1.1e-6 (red blood
-//   cell) and 2.4e-7 (ellipsoid) at 1280 triangles, 2.2e-6 and 4.4e-7 at 5120, where one evaluation
-//   is 1.25 (red blood cell) and 1.47 (ellipsoid) times faster than all7 on one thread (wall
-//   clock on a shared 2-core machine; on two threads there the ratios, 0.6 and 1.1, were
-//   dominated by other load). Per node about 8500 7-point and 6100 proxy points are summed
-//   instead of 35840, so the sums alone would be 2.4 times faster; the rest is the set-up
-//   (moments about 12 %, boxes 5 %), the traversal and the polar integrals (together about 20 %).
-//   The 3x target at 1e-5 is not reached at 5120 triangles; the rule is not the default.
+//   --benchmark_filter='BM_QuadratureRatio/.*_tree/triangles:(1280|5120)/' --benchmark_min_time=2)
+//   with the defaults (32, 7, 1.5, 2e-6), max_i |u_tree - u_all7| / max_i |u_all7|: 1.2e-6 (red
+//   blood cell) and 2.8e-7 (ellipsoid) at 1280 triangles, 2.2e-6 and 4.4e-7 at 5120. Speed-up over
+//   all7 (wall clock, one run each, on a shared 2-core machine with a load average of 6): at 5120
+//   triangles 1.14 (red blood cell) and 1.47 (ellipsoid) on one thread, 1.19 and 1.25 on two; at
+//   1280 the tree is slower (0.6 to 0.7). At 5120 each node sums about 8500 7-point and 6100
+//   proxy points instead of 35840, so the sums alone would be about 2.4 times faster; the rest is
+//   the set-up (moments about 12 %, boxes 5 %), the traversal and the polar integrals (together
+//   about 20 %). The 3x target at 1e-5 is not reached at 5120 triangles; the rule is not the default.
 //   Every cluster that contains a corner at x_i lies within rho_c of x_i, so far_ratio > 1 keeps
 //   the triangles at x_i on the 7-point rule, which the singular correction below takes back.
 // - Triangles that contain x_i: polar coordinates (rho, phi) centred on x_i [118]. There
@@ -95,7 +95,7 @@ struct SingleLayerOptions {
   int cluster_size = 32;   ///< adaptive: triangles per cluster (>= 1)
   int far_order = 1;       ///< adaptive: the far rule matches the cluster's moments up to this degree (0..4)
   double far_ratio = 4.0;  ///< adaptive: far when |x_i - c_c| >= far_ratio * rho_c (> 1)
-  int tree_leaf_size = 16;  ///< tree: at most this many triangles per leaf cluster (>= 1)
+  int tree_leaf_size = 32;  ///< tree: at most this many triangles per leaf cluster (>= 1)
   int tree_order = 7;       ///< tree: the proxies interpolate the kernel to this total degree (0..8)
   double tree_ratio = 1.5;  ///< tree: far only when |x_i - c_j| >= tree_ratio * rho_j (> 1)
   double tree_tolerance = 2e-6;  ///< tree: and when the far field's error estimate is below this (>= 0)
