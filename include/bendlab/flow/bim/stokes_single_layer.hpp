@@ -32,6 +32,8 @@
 //   the gain is 1.2 times at most: with a cluster's far zone beginning 6 to 10 radii away, most of
 //   a 5120-triangle capsule is near every cluster, and the 7-point rule dominates. The adaptive rule
 //   therefore is not the default (a hierarchical, treecode-like far field would be needed).
+//   Every cluster that contains a corner at x_i lies within rho_c of x_i, so far_ratio > 1 keeps
+//   the triangles at x_i on the 7-point rule, which the singular correction below takes back.
 //   (tree) a hierarchical far field:
 //     * clusters: a binary tree over the faces, halving each range until it holds at most
 //       `tree_leaf_size` faces; per evaluation the faces are sorted by Morton key and then split
@@ -62,11 +64,12 @@
 //   all7 (wall clock, one run each, on a shared 2-core machine with a load average of 6): at 5120
 //   triangles 1.14 (red blood cell) and 1.47 (ellipsoid) on one thread, 1.19 and 1.25 on two; at
 //   1280 the tree is slower (0.6 to 0.7). At 5120 each node sums about 8500 7-point and 6100
-//   proxy points instead of 35840, so the sums alone would be about 2.4 times faster; the rest is
+//   proxy points instead of 35840 (counted with tree_tolerance 3e-6 and leaves of 16), so the
+//   sums alone would be about 2.4 times faster; the rest is
 //   the set-up (moments about 12 %, boxes 5 %), the traversal and the polar integrals (together
 //   about 20 %). The 3x target at 1e-5 is not reached at 5120 triangles; the rule is not the default.
-//   Every cluster that contains a corner at x_i lies within rho_c of x_i, so far_ratio > 1 keeps
-//   the triangles at x_i on the 7-point rule, which the singular correction below takes back.
+//   Not tried: single-precision proxy sums, target clusters sharing one traversal, a cheaper rule
+//   for near triangles a few edge lengths away (the 7-point sums are now over half the work).
 // - Triangles that contain x_i: polar coordinates (rho, phi) centred on x_i [118]. There
 //   G dS = (I + e e^T) / rho * rho drho dphi, the singularity cancels, and with f linear along
 //   each ray the radial integral is exact: int_0^rho_max f drho = rho_max (f(x_i) + f_edge(phi)) / 2.
