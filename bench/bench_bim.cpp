@@ -7,13 +7,14 @@
 //                         StokesSingleLayer::velocity at every node, force density f = n z
 //                         (n the outward normal): quadrature set-up, the regular rule (all7: the
 //                         7-point rule over every triangle for every node; adaptive: the 7-point
-//                         rule near, the moment-corrected centroid rule far), and the polar
-//                         integrals at each node's triangles.
-//   BM_QuadratureRatio/<shape> (arguments: triangles, threads) both quadratures on one shape in
-//                         every iteration, force density = Method C's bending force density
-//                         (kB = 1) on that shape: counters speedup = (time of all7) / (time of
-//                         adaptive), summed over the iterations of this one run, and rel_diff =
-//                         max_i |u_adaptive(x_i) - u_all7(x_i)| / max_i |u_all7(x_i)|. Shapes: the
+//                         rule near, the moment-corrected centroid rule far; tree: the 7-point
+//                         rule near, cluster-tree proxies far), and the polar integrals at each
+//                         node's triangles.
+//   BM_QuadratureRatio/<shape>[_tree] (arguments: triangles, threads) all7 and adaptive (or tree)
+//                         on one shape in every iteration, force density = Method C's bending
+//                         force density (kB = 1) on that shape: counters speedup = (time of all7) /
+//                         (time of the other rule), summed over the iterations of this one run,
+//                         and rel_diff = max_i |u(x_i) - u_all7(x_i)| / max_i |u_all7(x_i)|. Shapes: the
 //                         red blood cell of eq. (15) (R = 1) and the ellipsoid of half axes
 //                         2, 1, 0.5, both mapped from the MT1 sphere.
 //   BM_StokesletReference/<isa>
@@ -108,10 +109,11 @@ void BM_SingleLayer(benchmark::State& state, SingleLayerQuadrature quadrature) {
       ->Unit(benchmark::kMillisecond)
 BENDLAB_SINGLE_LAYER(all7, SingleLayerQuadrature::all7);
 BENDLAB_SINGLE_LAYER(adaptive, SingleLayerQuadrature::adaptive);
+BENDLAB_SINGLE_LAYER(tree, SingleLayerQuadrature::tree);
 
 enum Shape { kRbc, kEllipsoid };
 
-void BM_QuadratureRatio(benchmark::State& state, Shape shape) {
+void BM_QuadratureRatio(benchmark::State& state, Shape shape, SingleLayerQuadrature quadrature) {
   const TriMesh& sphere = unit_sphere(static_cast<int>(state.range(0)));
   const int threads = static_cast<int>(state.range(1));
   omp_set_num_threads(threads);
@@ -124,40 +126,42 @@ void BM_QuadratureRatio(benchmark::State& state, Shape shape) {
   }
   const BendingResult bending = make_bending_method("C")->compute(sphere.topology(), x, 1.0);
   const Points& f = bending.force_density;
-  SingleLayerOptions reference_options, adaptive_options;
+  SingleLayerOptions reference_options, other_options;
   reference_options.quadrature = SingleLayerQuadrature::all7;
-  adaptive_options.quadrature = SingleLayerQuadrature::adaptive;
+  other_options.quadrature = quadrature;
   const StokesSingleLayer reference(sphere.topology_ptr(), reference_options);
-  const StokesSingleLayer adaptive(sphere.topology_ptr(), adaptive_options);
+  const StokesSingleLayer other(sphere.topology_ptr(), other_options);
   Points u_ref(x.rows(), 3), u(x.rows(), 3);
-  double t_ref = 0, t_adaptive = 0;
+  double t_ref = 0, t_other = 0;
   using Clock = std::chrono::steady_clock;
   for (auto _ : state) {
     const auto t0 = Clock::now();
     reference.velocity(x, f, 1.0, u_ref);
     const auto t1 = Clock::now();
-    adaptive.velocity(x, f, 1.0, u);
+    other.velocity(x, f, 1.0, u);
     const auto t2 = Clock::now();
     benchmark::DoNotOptimize(u.data());
     benchmark::DoNotOptimize(u_ref.data());
     t_ref += std::chrono::duration<double>(t1 - t0).count();
-    t_adaptive += std::chrono::duration<double>(t2 - t1).count();
+    t_other += std::chrono::duration<double>(t2 - t1).count();
   }
   state.counters["triangles"] = sphere.num_faces();
   state.counters["threads"] = threads;
   state.counters["s_all7"] = t_ref / static_cast<double>(state.iterations());
-  state.counters["s_adaptive"] = t_adaptive / static_cast<double>(state.iterations());
-  state.counters["speedup"] = t_ref / t_adaptive;
+  state.counters["s_" + to_string(quadrature)] = t_other / static_cast<double>(state.iterations());
+  state.counters["speedup"] = t_ref / t_other;
   state.counters["rel_diff"] = (u - u_ref).rowwise().norm().maxCoeff() / u_ref.rowwise().norm().maxCoeff();
 }
-#define BENDLAB_RATIO(name, shape)                    \
-  BENCHMARK_CAPTURE(BM_QuadratureRatio, name, shape)  \
+#define BENDLAB_RATIO(name, shape, q)                    \
+  BENCHMARK_CAPTURE(BM_QuadratureRatio, name, shape, q)  \
       ->ArgsProduct({{1280, 5120, 20480}, {1, 2}})    \
       ->ArgNames({"triangles", "threads"})            \
       ->UseRealTime()                                 \
       ->Unit(benchmark::kMillisecond)
-BENDLAB_RATIO(rbc, kRbc);
-BENDLAB_RATIO(ellipsoid, kEllipsoid);
+BENDLAB_RATIO(rbc, kRbc, SingleLayerQuadrature::adaptive);
+BENDLAB_RATIO(ellipsoid, kEllipsoid, SingleLayerQuadrature::adaptive);
+BENDLAB_RATIO(rbc_tree, kRbc, SingleLayerQuadrature::tree);
+BENDLAB_RATIO(ellipsoid_tree, kEllipsoid, SingleLayerQuadrature::tree);
 
 // Quadrature points and weighted densities of the 7-point rule on every triangle, structure of
 // arrays, as the solver lays them out.

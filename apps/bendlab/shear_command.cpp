@@ -144,10 +144,12 @@ const CommandRegistration registration([](CLI::App& app) {
                   "time integrator of the BIM: cash-karp (the paper's) or rkc (Runge-Kutta-Chebyshev, stiff-stable)")
       ->check(CLI::IsMember({"cash-karp", "rkc"}))->capture_default_str()->each(tolerance);
   cmd->add_option("--bim-quadrature", args->bim_quadrature,
-                  "regular quadrature of the BIM's single layer: all7 (the 7-point rule everywhere, the reference) "
-                  "or adaptive (7-point rule near each node, moment-corrected centroid rule far: 1.1 to 1.5 times "
-                  "faster at 5120 triangles, velocities within about 1e-4 of all7)")
-      ->check(CLI::IsMember({"all7", "adaptive"}))->capture_default_str()->each(tolerance);
+                  "regular quadrature of the BIM's single layer: all7 (the 7-point rule everywhere, the reference), "
+                  "adaptive (7-point rule near each node, moment-corrected centroid rule far: 1.1 to 1.5 times "
+                  "faster at 5120 triangles, velocities within about 1e-4 of all7) or tree (7-point rule near, "
+                  "proxies of a cluster tree far: 1.1 to 1.5 times faster at 5120 triangles, slower at 1280, "
+                  "velocities within about 2e-6 of all7)")
+      ->check(CLI::IsMember({"all7", "adaptive", "tree"}))->capture_default_str()->each(tolerance);
   auto lattice = [args](const std::string&) { args->given_lattice = true; };
   cmd->add_option("--rtol", args->rtol, "relative tolerance of the adaptive integrator (bim); above 1e-2 refused, "
                   "above 1e-4 warned (less accurate D, theta)")->capture_default_str()->each(tolerance);

@@ -417,6 +417,9 @@ TEST_F(Cli, ShearBimQuadratureIsRecordedAndPartOfTheIdentity) {
   const fs::path ref = dir / "all7";
   ASSERT_EQ(run("shear" + common + ref.string()).status, 0);
   EXPECT_EQ(nlohmann::json::parse(slurp(ref / "summary.json"))["bim_quadrature"], "all7");
+  const fs::path tree = dir / "tree";
+  ASSERT_EQ(run("shear --bim-quadrature tree" + common + tree.string()).status, 0);
+  EXPECT_EQ(nlohmann::json::parse(slurp(tree / "summary.json"))["bim_quadrature"], "tree");
   expect_refused(run("shear --bim-quadrature fast" + common + (dir / "f").string()), "bim-quadrature", dir / "f");
   expect_refused(run("shear --solver lbm --bim-quadrature adaptive" + common + (dir / "l").string()),
                  "--bim-quadrature", dir / "l");

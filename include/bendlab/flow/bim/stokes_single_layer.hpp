@@ -34,6 +34,42 @@
 //   therefore is not the default (a hierarchical, treecode-like far field would be needed).
 //   Every cluster that contains a corner at x_i lies within rho_c of x_i, so far_ratio > 1 keeps
 //   the triangles at x_i on the 7-point rule, which the singular correction below takes back.
+//   (tree) a hierarchical far field:
+//     * clusters: a binary tree over the faces, halving each range until it holds at most
+//       `tree_leaf_size` faces; per evaluation the faces are sorted by Morton key and then split
+//       top down at the median centroid along the widest extent of the cluster's centroids (a k-d
+//       tree: compact clusters whatever the shape). Cluster j has a box along the principal axes
+//       of its triangle corners, centre c_j, half widths h_j, radius rho_j = |h_j|;
+//     * far field of a cluster: the kernel G(y, x) is interpolated in y over the box by a
+//       polynomial of total degree q = `tree_order` in the Chebyshev basis T_a T_b T_c (a + b + c
+//       <= q), at m = (q + 1)(q + 2)(q + 3)/6 proxy points (approximate Fekete points picked once
+//       by column-pivoted QR from a tensor Chebyshev grid in [-1, 1]^3, mapped to the box; 120 for
+//       q = 7). Proxy weights W_m = sum_k L_m(y_k) w_k f_k (L_m the Lagrange basis at the proxies)
+//       come from the Chebyshev moments of the cluster's 7-point points (leaves) or of its
+//       children's proxies, which carry their moments of degree <= q exactly (a polynomial of
+//       degree <= q in the parent's box is one in the child's), so each level costs O(m^2);
+//       clusters whose proxies would be more than half their 7-point points keep those points;
+//     * a node x_i uses cluster j's proxies when |x_i - c_j| >= d_j, d_j = max(tree_ratio rho_j,
+//       (A_j rho_j^(q+1) / (tau U))^(1/(q+2))), A_j = sum |w_k f_k| over the cluster, U = sum |w_k f_k|
+//       over the surface / (half diagonal of its bounding box), tau = `tree_tolerance`; else it
+//       descends, and near leaves sum the 7-point rule (consecutive ranges in one call). The Taylor
+//       remainder of G about c_j bounds the interpolation error of a cluster's contribution by
+//       about A_j (rho_j / d)^(q+1) / d times the Lebesgue constant of the proxies, so the
+//       acceptance keeps each accepted cluster's error below about tau U, at most tree_ratio
+//       (> 1) box radii away, which keeps every node off the far field of its own triangles.
+//   Measured (tests/flow/test_stokes_single_layer.cpp; bench: ./build/release/bench_bim
+//   --benchmark_filter='BM_QuadratureRatio/.*_tree/triangles:(1280|5120)/' --benchmark_min_time=2)
+//   with the defaults (32, 7, 1.5, 2e-6), max_i |u_tree - u_all7| / max_i |u_all7|: 1.2e-6 (red
+//   blood cell) and 2.8e-7 (ellipsoid) at 1280 triangles, 2.2e-6 and 4.4e-7 at 5120. Speed-up over
+//   all7 (wall clock, one run each, on a shared 2-core machine with a load average of 6): at 5120
+//   triangles 1.14 (red blood cell) and 1.47 (ellipsoid) on one thread, 1.19 and 1.25 on two; at
+//   1280 the tree is slower (0.6 to 0.7). At 5120 each node sums about 8500 7-point and 6100
+//   proxy points instead of 35840 (counted with tree_tolerance 3e-6 and leaves of 16), so the
+//   sums alone would be about 2.4 times faster; the rest is
+//   the set-up (moments about 12 %, boxes 5 %), the traversal and the polar integrals (together
+//   about 20 %). The 3x target at 1e-5 is not reached at 5120 triangles; the rule is not the default.
+//   Not tried: single-precision proxy sums, target clusters sharing one traversal, a cheaper rule
+//   for near triangles a few edge lengths away (the 7-point sums are now over half the work).
 // - Triangles that contain x_i: polar coordinates (rho, phi) centred on x_i [118]. There
 //   G dS = (I + e e^T) / rho * rho drho dphi, the singularity cancels, and with f linear along
 //   each ray the radial integral is exact: int_0^rho_max f drho = rho_max (f(x_i) + f_edge(phi)) / 2.
@@ -51,8 +87,9 @@
 namespace bendlab {
 
 /// all7: the 7-point rule on every non-singular triangle for every target (the reference, default);
-/// adaptive: the 7-point rule near the target, the moment-corrected centroid rule far from it.
-enum class SingleLayerQuadrature { all7, adaptive };
+/// adaptive: the 7-point rule near the target, the moment-corrected centroid rule far from it;
+/// tree: the 7-point rule near the target, Chebyshev proxies of a cluster tree far from it.
+enum class SingleLayerQuadrature { all7, adaptive, tree };
 
 struct SingleLayerOptions {
   int angular_points = 8;        ///< Gauss-Legendre points per sub-angle of a singular triangle
@@ -61,9 +98,13 @@ struct SingleLayerOptions {
   int cluster_size = 32;   ///< adaptive: triangles per cluster (>= 1)
   int far_order = 1;       ///< adaptive: the far rule matches the cluster's moments up to this degree (0..4)
   double far_ratio = 4.0;  ///< adaptive: far when |x_i - c_c| >= far_ratio * rho_c (> 1)
+  int tree_leaf_size = 32;  ///< tree: at most this many triangles per leaf cluster (>= 1)
+  int tree_order = 7;       ///< tree: the proxies interpolate the kernel to this total degree (0..8)
+  double tree_ratio = 1.5;  ///< tree: far only when |x_i - c_j| >= tree_ratio * rho_j (> 1)
+  double tree_tolerance = 2e-6;  ///< tree: and when the far field's error estimate is below this (>= 0)
 };
 
-/// "all7" | "adaptive"; the inverse throws bendlab::Error naming the unknown value.
+/// "all7" | "adaptive" | "tree"; the inverse throws bendlab::Error naming the unknown value.
 std::string to_string(SingleLayerQuadrature q);
 SingleLayerQuadrature single_layer_quadrature(const std::string& name);
 
@@ -80,6 +121,7 @@ class StokesSingleLayer {
 
  private:
   void prepare(const Points& x, const Points& f) const;
+  void prepare_tree(const Points& x) const;
 
   TopologyPtr topology_;
   SingleLayerOptions options_;
@@ -94,6 +136,18 @@ class StokesSingleLayer {
   // squared times far_ratio^2, and whether the far rule may be used.
   mutable std::vector<double> px_, py_, pz_, pfx_, pfy_, pfz_;
   mutable std::vector<double> cx_, cy_, cz_, far2_;
+  // tree: clusters in breadth-first order (the root first; the children of a cluster are
+  // consecutive), each the range [tree_begin_, tree_end_) of sorted faces, its first child (-1: a
+  // leaf), its proxy slot (-1: none) and the first cluster of each depth. Built once.
+  std::vector<int> tree_begin_, tree_end_, tree_child_, tree_proxy_, tree_level_;
+  // Degrees (a, b, c) of the Chebyshev basis, reference proxies in [-1, 1]^3 (x, y, z each) and
+  // the Lagrange basis at them in the Chebyshev basis (C(beta, m) at beta * count + m).
+  std::vector<int> tree_basis_;
+  std::vector<double> tree_reference_, tree_lagrange_;
+  // Per evaluation: box centres, far distance squared, proxy counts (0: none) and the proxies.
+  mutable std::vector<int> tree_count_;
+  mutable std::vector<double> bcx_, bcy_, bcz_, tree_far2_;
+  mutable std::vector<double> tpx_, tpy_, tpz_, tfx_, tfy_, tfz_;
 };
 
 /// The 7-point degree-5 rule on a triangle: barycentric coordinates (of corners 0, 1, 2) and
