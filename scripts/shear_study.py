@@ -27,6 +27,8 @@ Writes docs/results/shear.md and the PNGs it shows (docs/results/shear/):
       kB_hat = 0.0375), figure 17 (A and C at kB_hat = 2/15, G = 0.05 and 0.2) and the study's wall
       time. 5 + 2 x (number of methods) + 4 runs (25 with A, B, C, D, E, ED, S, J). The paper gives
       the literature values of figures 16 and 17 only as plots, so they are not drawn.
+      --bim-quadrature-e tree runs them with the BIM's tree quadrature (within 1e-5 of all7;
+      Method C at 5120 to gamma t = 10 in 249 s on 2 idle cores, D_steady equal to all7's to 1.4e-7).
       The section sits between markers at the end of --doc: --only e replaces it (or appends it)
       and leaves the rest of the document as it is; a run of parts (a)-(c) keeps it. Run it in the
       background, one thread per run. Estimate (not a measured study): about 10 hours of run time,
@@ -88,6 +90,10 @@ PAIRS = [(0.05, 0.0375), (0.2, 0.15)]
 # Part (e), the paper's resolution: every run with the stiff-stable Runge-Kutta-Chebyshev
 # integrator (docs/results/stiff_stepping.md) at the tolerances of the paper's Cash-Karp runs.
 E_INTEGRATOR = "rkc"
+# The BIM's regular quadrature of part (e) (`--bim-quadrature-e`): all7 (the reference) or tree
+# (within 1e-5 of it, faster at 5120 triangles). Part of an RKC run's identity: a tree run's folder
+# name ends in _tree and its summary.json must name the quadrature.
+E_QUADRATURE = "all7"
 RTOL, ATOL = "1e-7", "1e-6"
 FIG16_METHODS = ["C", "S"]  # figure 16: G = 0.05, kB_hat = 0.0375 (runs of figure 14)
 FIG17_KB = 2.0 / 15.0  # figure 17: Methods A and C at kB_hat = 2/15, G = 0.05 and 0.2
@@ -173,7 +179,13 @@ class Run:
     def name(self):
         # Cash-Karp runs keep the names they always had (their work folders stay valid).
         return (f"{self.method}_mt1-{self.triangles}_G{fmt_g(self.G)}_kb{fmt_g(self.kappa_b)}"
-                f"_t{fmt_g(self.t_end)}" + ("" if self.integrator == "cash-karp" else f"_{self.integrator}"))
+                f"_t{fmt_g(self.t_end)}" + ("" if self.integrator == "cash-karp" else f"_{self.integrator}")
+                + ("" if self.quadrature == "all7" else f"_{self.quadrature}"))
+
+    @property
+    def quadrature(self):
+        """The BIM quadrature: E_QUADRATURE for part (e)'s runs, all7 for the Cash-Karp ones."""
+        return "all7" if self.integrator == "cash-karp" else E_QUADRATURE
 
     def label(self):
         return (f"method {self.method:>4}, {self.triangles:4d} triangles, G = {fmt_g(self.G)}, "
@@ -187,6 +199,8 @@ class Run:
             # The tolerances of the paper's Cash-Karp runs (which are bendlab shear's defaults),
             # spelled out so that the command line says what was run.
             args += ["--integrator", self.integrator, "--rtol", RTOL, "--atol", ATOL]
+        if self.quadrature != "all7":
+            args += ["--bim-quadrature", self.quadrature]
         return args
 
 
@@ -213,7 +227,8 @@ def summary_matches(summary, run):
         ok = (summary.get("method") == run.method and summary.get("mesh") == run.mesh
               and close(summary.get("G"), run.G) and close(summary.get("kappa_b_hat"), run.kappa_b)
               and close(summary.get("t_end"), run.t_end)
-              and summary.get("integrator", "cash-karp") == run.integrator)
+              and summary.get("integrator", "cash-karp") == run.integrator
+              and summary.get("bim_quadrature", "all7") == run.quadrature)
         if ok and run.integrator != "cash-karp":
             ok = close(summary.get("rtol"), float(RTOL)) and close(summary.get("atol"), float(ATOL))
         return ok
@@ -259,7 +274,8 @@ def checkpoint_matches(run_dir, run):
         return False
     return (args.get("method") == run.method and args.get("mesh") == run.mesh
             and close(args.get("G"), run.G) and close(args.get("kappa_b_hat"), run.kappa_b)
-            and args.get("integrator", "cash-karp") == run.integrator)
+            and args.get("integrator", "cash-karp") == run.integrator
+            and args.get("bim_quadrature", "all7") == run.quadrature)
 
 
 def execute(run, work, bendlab, counter, total):
@@ -734,7 +750,9 @@ def section_e(results, runs, fig_dir, rel, t_end, n, meta):
              + ("" if t_end >= 10 else " (a preview: the paper runs to 10)"),
              "",
              f"Every run is `bendlab shear --method M --mesh mt1:{n} --G G --kappa-b-hat KB --t-end T --no-plot "
-             f"--integrator {it} --rtol {RTOL} --atol {ATOL}`: the boundary integral method as in parts "
+             f"--integrator {it} --rtol {RTOL} --atol {ATOL}"
+             + ("" if E_QUADRATURE == "all7" else f" --bim-quadrature {E_QUADRATURE}")
+             + "`: the boundary integral method as in parts "
              "(a)-(c), but stepped by the second-order Runge-Kutta-Chebyshev method, whose stages grow with "
              "the stiffness bending adds so that the step is set by accuracy, not by stability "
              "(docs/results/stiff_stepping.md: at 5120 triangles it agrees with Cash-Karp to 5e-6 in D at "
@@ -980,6 +998,9 @@ def main():
     ap.add_argument("--triangles-a", type=int, default=1280, help="resolution of part (a) (default 1280)")
     ap.add_argument("--triangles-e", type=int, default=5120,
                     help="resolution of part (e) (default 5120, the paper's; smaller for a quick preview)")
+    ap.add_argument("--bim-quadrature-e", choices=["all7", "tree"], default="all7",
+                    help="BIM quadrature of part (e)'s runs: all7 (default, the reference) or tree (within "
+                         "1e-5 of it, faster at 5120 triangles; its runs are cached under names ending in _tree)")
     ap.add_argument("--list", action="store_true",
                     help="print the runs the chosen parts need, with their command lines and whether each "
                          "is done, can resume from a checkpoint or is still to run; runs nothing")
@@ -989,6 +1010,8 @@ def main():
                          "writes them into a section of their own at the end of the document, leaving the "
                          "rest of it as it is")
     args = ap.parse_args()
+    global E_QUADRATURE
+    E_QUADRATURE = args.bim_quadrature_e
     if args.jobs < 1:
         ap.error("--jobs must be at least 1")
     if not args.t_end > 0:
