@@ -13,6 +13,8 @@
 //                  pattern writes back to the lines it read, so no write-allocate traffic);
 //                  bound_fraction = GBps / (the triad's traffic_GBps on as many threads), the
 //                  fraction of the bandwidth bound of this layout that the kernel reaches.
+//   BM_LbmStep<collision>Unpadded  the same with the slots num_nodes() apart (pad_slots = false),
+//                  the plain layout the padded one is measured against.
 //   BM_MembraneIbm/<threads>  the capsule's part of one IB-LBM step in the paper's full-size case:
 //                  5120 triangles (2562 nodes) of R = 13.5 dx centred in the same 128^3 box,
 //                  neo-Hookean + bending (method A, ESPResSo's tribend) + ESPResSo's volume force,
@@ -24,6 +26,7 @@
 
 #include <algorithm>
 #include <map>
+#include <utility>
 #include <memory>
 #include <vector>
 
@@ -96,27 +99,27 @@ void BM_StreamTriad(benchmark::State& state) {
 }
 BENCHMARK(BM_StreamTriad)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
 
-Lattice& shear_box(Collision collision) {
-  static std::map<Collision, std::unique_ptr<Lattice>> cache;
-  auto& L = cache[collision];
-  if (!L) {
+Lattice& shear_box(Collision collision, bool padded = true) {
+  static std::map<std::pair<Collision, bool>, std::unique_ptr<Lattice>> cache;
+  const std::pair key(collision, padded);
+  if (!cache[key]) {
     cache.clear();  // one 128^3 lattice (about 370 MB) at a time
     LatticeConfig c;
     c.nx = c.ny = c.nz = 128;
     c.tau = collision == Collision::BGK ? 1.0 : 0.8;
     c.collision = collision;
     c.wall_velocity = 0.01;
-    cache[collision] = std::make_unique<Lattice>(c);
-    cache[collision]->initialise_shear_flow();
-    return *cache[collision];
+    c.pad_slots = padded;
+    cache[key] = std::make_unique<Lattice>(c);
+    cache[key]->initialise_shear_flow();
   }
-  return *L;
+  return *cache[key];
 }
 
-void lbm_step(benchmark::State& state, Collision collision) {
+void lbm_step(benchmark::State& state, Collision collision, bool padded = true) {
   const int threads = static_cast<int>(state.range(0));
   omp_set_num_threads(threads);
-  Lattice& L = shear_box(collision);
+  Lattice& L = shear_box(collision, padded);
   L.run(2);  // warm up both parities
   for (auto _ : state) L.step();
   const double updates = static_cast<double>(state.iterations()) * static_cast<double>(L.num_nodes());
@@ -168,6 +171,10 @@ void BM_MembraneIbm(benchmark::State& state) {
                            benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 void BM_LbmStepRegularized(benchmark::State& state) { lbm_step(state, Collision::Regularized); }
+// The same steps with the slots num_nodes() apart (LatticeConfig::pad_slots = false), the layout
+// the padding replaced: 128^3 puts the 41 streams of a row a power of two apart.
+void BM_LbmStepBGKUnpadded(benchmark::State& state) { lbm_step(state, Collision::BGK, false); }
+void BM_LbmStepRegularizedUnpadded(benchmark::State& state) { lbm_step(state, Collision::Regularized, false); }
 
 // Measures the triad once per thread count for bound_fraction (not reported by itself).
 void BM_TriadReference(benchmark::State& state) {
@@ -194,6 +201,8 @@ void BM_TriadReference(benchmark::State& state) {
 BENCHMARK(BM_TriadReference)->Arg(1)->Arg(2)->Iterations(1)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_LbmStepBGK)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_LbmStepRegularized)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_LbmStepBGKUnpadded)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_LbmStepRegularizedUnpadded)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_MembraneIbm)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
 
 }  // namespace

@@ -53,10 +53,10 @@ void write_checkpoint(const DistributedLattice& lattice, const std::filesystem::
     agree(comm, fmt::format("cannot create LBM checkpoint {}", temp.string()));
   }
   agree(comm, "");
-  const std::size_t n = lattice.local().num_nodes();
+  const std::size_t n = lattice.local().slot_stride();
   const std::size_t layer = static_cast<std::size_t>(g.nx) * s.count;
   const std::size_t nl = static_cast<std::size_t>(s.count) + 2;
-  const double* f = lattice.local().raw_populations().data();
+  const double* f = lattice.local().raw_data();
   bool ok = true;
   if (s.rank == 0) {
     const std::string header = lbm::checkpoint_header(g, lattice.step_count());

@@ -69,7 +69,7 @@ void DistributedLattice::step() {
 
 void DistributedLattice::exchange(bool fill) {
   const int nx = global_.nx, nz = global_.nz, nl = slab_.count + 2;
-  const std::size_t n = local_.num_nodes();
+  const std::size_t n = local_.slot_stride();
   double* f = local_.raw_data();
   const int lo = (slab_.rank + slab_.ranks - 1) % slab_.ranks, hi = (slab_.rank + 1) % slab_.ranks;
   auto at = [&](int q, int jl, int k) { return f + q * n + static_cast<std::size_t>(nx) * (jl + static_cast<std::size_t>(nl) * k); };
@@ -130,7 +130,7 @@ void DistributedLattice::restore_owned(const std::vector<double>& owned, std::in
   for (int q = 0; q < lbm::kQ; ++q)
     for (int k = 0; k < nz; ++k, src += layer)
       std::copy_n(src, layer, raw.data() + q * n + static_cast<std::size_t>(nx) * (1 + static_cast<std::size_t>(nl) * k));
-  local_.restore_raw(std::move(raw), step);
+  local_.restore_raw(raw, step);
   if (step % 2 == 1) exchange(true);
 }
 

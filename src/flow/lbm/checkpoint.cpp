@@ -85,10 +85,10 @@ void read_checkpoint(Lattice& lattice, const std::filesystem::path& path) {
   const std::string name = path.string();
   std::ifstream in(path, std::ios::binary);
   in.seekg(static_cast<std::streamoff>(kCheckpointHeaderBytes));
-  std::vector<double> f(lattice.raw_populations().size());
+  std::vector<double> f(kQ * lattice.num_nodes());
   in.read(reinterpret_cast<char*>(f.data()), static_cast<std::streamsize>(f.size() * sizeof(double)));
   if (!in) throw Error(fmt::format("LBM checkpoint {} could not be read to the end", name));
-  lattice.restore_raw(std::move(f), step);
+  lattice.restore_raw(f, step);
 }
 
 }  // namespace bendlab::lbm

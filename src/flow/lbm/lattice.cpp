@@ -165,7 +165,7 @@ constexpr std::size_t kParallelNodes = std::size_t{1} << 15;
 
 struct StepArgs {
   double* f;
-  std::size_t n;
+  std::size_t stride;  // doubles between two slots (Lattice::slot_stride)
   int nx, ny, nz;
   int j0, nj;  // the layers stepped: j0 <= j < j0 + nj (all of them: 0, ny)
   bool walls, odd;
@@ -220,7 +220,7 @@ LBM_INLINE void row_kernel(const RowPlan& p, const double* Fx, const double* Fy,
 // (x - c_x stays in the row), xe >= 0 those of the single node x = xe with periodic wrap in x.
 // Returns whether any link of the row meets a wall.
 bool odd_plan(const StepArgs& a, int j, int k, int xe, RowPlan& p) {
-  const std::size_t n = a.n;
+  const std::size_t n = a.stride;
   const std::ptrdiff_t row = static_cast<std::ptrdiff_t>(a.nx) * (j + static_cast<std::ptrdiff_t>(a.ny) * k);
   bool wall = false;
   for (int q = 0; q < kQ; ++q) {
@@ -274,8 +274,8 @@ LBM_INLINE void process_rows_impl(const StepArgs& a, int row0, int row1, const C
     const double* Fz = a.F[2] + row;
     if (!a.odd) {
       for (int q = 0; q < kQ; ++q) {
-        p.rbase[q] = a.f + q * a.n;
-        p.wbase[q] = a.f + opposite(q) * a.n;
+        p.rbase[q] = a.f + q * a.stride;
+        p.wbase[q] = a.f + opposite(q) * a.stride;
         p.roff[q] = p.woff[q] = row;
       }
       row_kernel<false>(p, Fx, Fy, Fz, 0, a.nx, coll);
@@ -330,8 +330,12 @@ Lattice::Lattice(const LatticeConfig& config) : config_(config) {
   collision_ = config.collision;
   if (collision_ == Collision::Auto) collision_ = config.tau == 1.0 ? Collision::BGK : Collision::Regularized;
   n_ = static_cast<std::size_t>(config.nx) * config.ny * config.nz;
-  f_.assign(kQ * n_, 0.0);
-  for (auto& F : force_) F.assign(n_, 0.0);
+  // A multiple of 4 KiB (512 doubles) plus 9 cache lines: the slots' starts fall on 19 (and the
+  // force components' on 3) different cache-line offsets modulo 4 KiB and modulo any larger power
+  // of two up to 9 * 64 lines, so a row's streams neither alias nor share cache sets.
+  stride_ = config.pad_slots ? (n_ + 511) / 512 * 512 + 72 : n_;
+  f_.assign(kQ * stride_, 0.0);
+  force_.assign(3 * stride_, 0.0);
   initialise([](const Vec3&) { return Vec3::Zero(); });
 }
 
@@ -366,7 +370,7 @@ void Lattice::initialise(const std::function<Vec3(const Vec3&)>& velocity,
             const Vec3 c(kCx[q], kCy[q], kCz[q]);
             v -= 3.0 * tau * kW[q] * rho * (c.dot(S * c) - S.trace() / 3.0);
           }
-          f_[q * n_ + node] = v;
+          f_[q * stride_ + node] = v;
         }
       }
     }
@@ -382,17 +386,17 @@ void Lattice::initialise_shear_flow() {
 }
 
 void Lattice::clear_force() {
-  for (auto& F : force_) std::fill(F.begin(), F.end(), 0.0);
+  std::fill(force_.begin(), force_.end(), 0.0);
 }
 
 void Lattice::set_uniform_force(const Vec3& F) {
-  for (int d = 0; d < 3; ++d) std::fill(force_[d].begin(), force_[d].end(), F[d]);
+  for (int d = 0; d < 3; ++d) std::fill_n(force_.begin() + d * stride_, n_, F[d]);
 }
 
 template <class Coll>
 void Lattice::step_with(const Coll& coll, int j0, int j1) {
-  StepArgs a{f_.data(), n_, config_.nx, config_.ny, config_.nz, j0, j1 - j0, config_.walls, step_ % 2 == 1,
-             config_.wall_velocity, {force_[0].data(), force_[1].data(), force_[2].data()}};
+  StepArgs a{f_.data(), stride_, config_.nx, config_.ny, config_.nz, j0, j1 - j0, config_.walls, step_ % 2 == 1,
+             config_.wall_velocity, {force_data(0), force_data(1), force_data(2)}};
   const int rows = (j1 - j0) * config_.nz;
   // Small lattices (tests) step on one thread: a parallel region costs more than their update.
 #pragma omp parallel if (n_ >= kParallelNodes)
@@ -420,7 +424,7 @@ void Lattice::step_layers(int j0, int j1) {
 
 void Lattice::populations(std::size_t node, double f[kQ]) const {
   if (step_ % 2 == 0) {
-    for (int q = 0; q < kQ; ++q) f[q] = f_[q * n_ + node];
+    for (int q = 0; q < kQ; ++q) f[q] = f_[q * stride_ + node];
     return;
   }
   // After an even step slot qbar of node x - c_q holds the post-collision f_q of that node.
@@ -429,10 +433,10 @@ void Lattice::populations(std::size_t node, double f[kQ]) const {
     const int ks = k - kCz[q];
     if (config_.walls && (ks < 0 || ks >= config_.nz)) {
       const double uw = ks < 0 ? -config_.wall_velocity : config_.wall_velocity;
-      f[q] = f_[q * n_ + node] + 6.0 * kW[q] * kCx[q] * uw;
+      f[q] = f_[q * stride_ + node] + 6.0 * kW[q] * kCx[q] * uw;
     } else {
       const std::size_t src = index(wrap(i - kCx[q], config_.nx), wrap(j - kCy[q], config_.ny), wrap(ks, config_.nz));
-      f[q] = f_[opposite(q) * n_ + src];
+      f[q] = f_[opposite(q) * stride_ + src];
     }
   }
 }
@@ -473,12 +477,18 @@ Vec3 Lattice::total_momentum() const {
   return p;
 }
 
-void Lattice::restore_raw(std::vector<double> populations, std::int64_t step) {
-  if (populations.size() != f_.size()) {
-    throw Error(fmt::format("LBM state has {} populations, the lattice needs {}", populations.size(), f_.size()));
+std::vector<double> Lattice::raw_populations() const {
+  std::vector<double> packed(kQ * n_);
+  for (int q = 0; q < kQ; ++q) std::copy_n(f_.begin() + q * stride_, n_, packed.begin() + q * n_);
+  return packed;
+}
+
+void Lattice::restore_raw(const std::vector<double>& populations, std::int64_t step) {
+  if (populations.size() != kQ * n_) {
+    throw Error(fmt::format("LBM state has {} populations, the lattice needs {}", populations.size(), kQ * n_));
   }
   if (step < 0) throw Error(fmt::format("LBM step count {} is negative", step));
-  f_ = std::move(populations);
+  for (int q = 0; q < kQ; ++q) std::copy_n(populations.begin() + q * n_, n_, f_.begin() + q * stride_);
   step_ = step;
 }
 

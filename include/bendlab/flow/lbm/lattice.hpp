@@ -27,12 +27,17 @@
 // in both steps, so each update moves 19 + 19 doubles plus the 3 force components: 328 bytes per
 // node update (no write-allocate traffic, no second lattice). Which slot holds which population
 // therefore depends on the parity of the step; populations() hides it.
+// The 19 slots (and the 3 force components) lie slot_stride() doubles apart, not num_nodes():
+// at power-of-two lattice sizes (128^3) arrays a power of two apart map the 41 streams of a row
+// onto the same cache sets and 4 KiB aliases, so each slot is padded to an odd number of cache
+// lines past a multiple of 4 KiB (slot_stride).
 #include <array>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <vector>
 
+#include "bendlab/core/aligned_allocator.hpp"
 #include "bendlab/core/types.hpp"
 #include "bendlab/flow/lbm/d3q19.hpp"
 
@@ -50,6 +55,9 @@ struct LatticeConfig {
   bool walls = true;             ///< walls at z = -+nz/2; false: fully periodic box
   double wall_velocity = 0.0;    ///< v: the top wall moves with +v e_x, the bottom one with -v e_x
   Collision collision = Collision::Auto;
+  /// Pads the slots of the store (slot_stride()); false puts them num_nodes() apart, the plain
+  /// layout kept as the reference the padded one is tested and benchmarked against.
+  bool pad_slots = true;
 };
 
 class Lattice {
@@ -94,15 +102,19 @@ class Lattice {
   /// and the caller clears it before spreading new forces.
   void clear_force();
   void add_force(std::size_t node, const Vec3& F) {
-    force_[0][node] += F.x();
-    force_[1][node] += F.y();
-    force_[2][node] += F.z();
+    double* f = force_.data();
+    f[node] += F.x();
+    f[stride_ + node] += F.y();
+    f[2 * stride_ + node] += F.z();
   }
   void set_uniform_force(const Vec3& F);
-  Vec3 force(std::size_t node) const { return {force_[0][node], force_[1][node], force_[2][node]}; }
+  Vec3 force(std::size_t node) const {
+    const double* f = force_.data();
+    return {f[node], f[stride_ + node], f[2 * stride_ + node]};
+  }
   /// Component d (0, 1, 2) of the force field, num_nodes() values.
-  double* force_data(int d) { return force_[d].data(); }
-  const double* force_data(int d) const { return force_[d].data(); }
+  double* force_data(int d) { return force_.data() + d * stride_; }
+  const double* force_data(int d) const { return force_.data() + d * stride_; }
 
   /// One step: collide with the force field (Guo), stream, bounce back at the walls. OpenMP over
   /// the (y, z) rows.
@@ -125,13 +137,18 @@ class Lattice {
   double total_mass() const;
   Vec3 total_momentum() const;
 
-  /// The raw population store, kQ * num_nodes() doubles, slot-major, in the AA layout of
-  /// step_count() (for checkpoints).
-  const std::vector<double>& raw_populations() const { return f_; }
-  /// The same store, writable (for the halo exchange of a subdomain, parallel/distributed_lattice.hpp).
+  /// The raw populations, kQ * num_nodes() doubles, slot-major without padding, in the AA layout
+  /// of step_count() (a copy, for checkpoints).
+  std::vector<double> raw_populations() const;
+  /// Distance in doubles between two slots of the store (num_nodes() or more, see the layout above).
+  std::size_t slot_stride() const { return stride_; }
+  /// The store itself: slot q of node n at raw_data()[q * slot_stride() + n] (for the halo
+  /// exchange and the checkpoint of a subdomain, parallel/distributed_lattice.hpp).
   double* raw_data() { return f_.data(); }
-  /// Replaces the raw store and the step count (sizes must match; for checkpoints).
-  void restore_raw(std::vector<double> populations, std::int64_t step);
+  const double* raw_data() const { return f_.data(); }
+  /// Replaces the populations (as raw_populations() gives them) and the step count (sizes must
+  /// match; for checkpoints).
+  void restore_raw(const std::vector<double>& populations, std::int64_t step);
 
  private:
   template <class Coll>
@@ -140,9 +157,10 @@ class Lattice {
   LatticeConfig config_;
   Collision collision_;
   std::size_t n_;
+  std::size_t stride_;
   std::int64_t step_ = 0;
-  std::vector<double> f_;
-  std::array<std::vector<double>, 3> force_;
+  AlignedDoubles f_;      // kQ slots of stride_ doubles
+  AlignedDoubles force_;  // 3 components of stride_ doubles
 };
 
 }  // namespace bendlab::lbm
