@@ -71,75 +71,122 @@ LBM_INLINE double csc(double sxx, double syy, double szz, double sxy, double sxz
     return 0.0;
   }
 }
-// sum_q c_q f_q along one axis: only the directions with a non-zero component.
-template <const std::array<int, kQ>& C, std::size_t... Q>
-LBM_INLINE double moment(const double* f, std::index_sequence<Q...>) {
-  double s = 0.0;
-  ((C[Q] == 1 ? (s += f[Q]) : (C[Q] == -1 ? (s -= f[Q]) : s)), ...);
-  return s;
-}
-template <std::size_t... Q>
-LBM_INLINE double sum(const double* f, std::index_sequence<Q...>) {
-  return (f[Q] + ...);
-}
-// sum_q c_qa c_qb f_q for a != b.
-template <const std::array<int, kQ>& A, const std::array<int, kQ>& B, std::size_t... Q>
-LBM_INLINE double cross_moment(const double* f, std::index_sequence<Q...>) {
-  double s = 0.0;
-  ((A[Q] * B[Q] == 1 ? (s += f[Q]) : (A[Q] * B[Q] == -1 ? (s -= f[Q]) : s)), ...);
-  return s;
-}
-// sum_q c_qa^2 f_q.
-template <const std::array<int, kQ>& A, std::size_t... Q>
-LBM_INLINE double square_moment(const double* f, std::index_sequence<Q...>) {
-  double s = 0.0;
-  ((A[Q] != 0 ? (s += f[Q]) : s), ...);
-  return s;
-}
 using Directions = std::make_index_sequence<kQ>;
+using Pairs = std::make_index_sequence<(kQ - 1) / 2>;  // pair k: directions 2k + 1 and 2k + 2 = opposite
 
-// BGK + Guo (technical note section 1), omega = 1/tau, a = 1 - 1/(2 tau).
+// The moments from the sums s_k = f_c + f_-c and differences d_k = f_c - f_-c of the 9 pairs of
+// opposite directions (c the odd one of the pair): rho = f_0 + sum s, j = sum c d,
+// Pi = sum c c s. Half the additions of summing the 19 directions moment by moment.
+struct PairSums {
+  double s[(kQ - 1) / 2], d[(kQ - 1) / 2];
+};
+template <std::size_t... K>
+LBM_INLINE PairSums pair_sums(const double* f, std::index_sequence<K...>) {
+  PairSums p;
+  ((p.s[K] = f[2 * K + 1] + f[2 * K + 2], p.d[K] = f[2 * K + 1] - f[2 * K + 2]), ...);
+  return p;
+}
+// sum_k c_a(k) v_k.
+template <const std::array<int, kQ>& C, std::size_t... K>
+LBM_INLINE double pair_moment(const double* v, std::index_sequence<K...>) {
+  double r = 0.0;
+  ((C[2 * K + 1] == 1 ? (r += v[K]) : (C[2 * K + 1] == -1 ? (r -= v[K]) : r)), ...);
+  return r;
+}
+// sum_k c_a(k) c_b(k) v_k for a != b, and sum_k c_a(k)^2 v_k.
+template <const std::array<int, kQ>& A, const std::array<int, kQ>& B, std::size_t... K>
+LBM_INLINE double pair_cross(const double* v, std::index_sequence<K...>) {
+  double r = 0.0;
+  ((A[2 * K + 1] * B[2 * K + 1] == 1 ? (r += v[K]) : (A[2 * K + 1] * B[2 * K + 1] == -1 ? (r -= v[K]) : r)), ...);
+  return r;
+}
+template <const std::array<int, kQ>& A, std::size_t... K>
+LBM_INLINE double pair_square(const double* v, std::index_sequence<K...>) {
+  double r = 0.0;
+  ((A[2 * K + 1] != 0 ? (r += v[K]) : r), ...);
+  return r;
+}
+template <std::size_t... K>
+LBM_INLINE double pair_total(const double* v, std::index_sequence<K...>) {
+  return (v[K] + ...);
+}
+
+// BGK + Guo (technical note section 1), omega = 1/tau, a = 1 - 1/(2 tau):
+//   f_i* = (1 - omega) f_i + omega f_i^eq + a w_i [3 (c_i - u).F + 9 (c_i.u)(c_i.F)],
+// evaluated per pair of opposite directions (c, -c): with A = c.u and B = c.F the added term is
+// w (even + odd) for c and w (even - odd) for -c, even = omega rho (1 - 1.5 u.u) - 3 a u.F
+// + 4.5 omega rho A^2 + 9 a A B and odd = 3 omega rho A + 3 a B, so each pair costs one
+// evaluation. kTauOne drops the (1 - omega) f_i term (omega = 1: the populations enter only
+// through their moments).
+template <bool kTauOne>
 struct Bgk {
   double omega, a;
-  template <std::size_t Q>
-  LBM_INLINE void relax(double* f, double rho, double ux, double uy, double uz, double uu, double uF,
-                    double Fx, double Fy, double Fz) const {
-    constexpr int X = kCx[Q], Y = kCy[Q], Z = kCz[Q];
-    const double cu = cdot<X, Y, Z>(ux, uy, uz);
-    const double cF = cdot<X, Y, Z>(Fx, Fy, Fz);
-    const double feq = kW[Q] * rho * (1.0 + 3.0 * cu + 4.5 * cu * cu - 1.5 * uu);
-    const double guo = kW[Q] * (3.0 * (cF - uF) + 9.0 * cu * cF);
-    f[Q] = f[Q] - omega * (f[Q] - feq) + a * guo;
+  template <std::size_t K>
+  LBM_INLINE void relax_pair(double* f, double keep, double e0, double e2, double e4, double o1, double o3,
+                             double ux, double uy, double uz, double Fx, double Fy, double Fz) const {
+    constexpr int q = 2 * static_cast<int>(K) + 1, qb = q + 1;  // the pair (2k - 1, 2k), k = K + 1
+    static_assert(opposite(q) == qb);
+    constexpr int X = kCx[q], Y = kCy[q], Z = kCz[q];
+    const double A = cdot<X, Y, Z>(ux, uy, uz);
+    const double B = cdot<X, Y, Z>(Fx, Fy, Fz);
+    const double even = kW[q] * (e0 + A * (e2 * A + e4 * B));
+    const double odd = kW[q] * (o1 * A + o3 * B);
+    if constexpr (kTauOne) {
+      f[q] = even + odd;
+      f[qb] = even - odd;
+    } else {
+      f[q] = keep * f[q] + (even + odd);
+      f[qb] = keep * f[qb] + (even - odd);
+    }
   }
-  template <std::size_t... Q>
-  LBM_INLINE void apply(double* f, double Fx, double Fy, double Fz, std::index_sequence<Q...> d) const {
-    const double rho = sum(f, d);
-    const double jx = moment<kCx>(f, d), jy = moment<kCy>(f, d), jz = moment<kCz>(f, d);
+  template <std::size_t... K>
+  LBM_INLINE void apply(double* f, double Fx, double Fy, double Fz, std::index_sequence<K...>) const {
+    const Pairs k;
+    const PairSums p = pair_sums(f, k);
+    const double rho = f[0] + pair_total(p.s, k);
+    const double jx = pair_moment<kCx>(p.d, k), jy = pair_moment<kCy>(p.d, k), jz = pair_moment<kCz>(p.d, k);
     const double ir = 1.0 / rho;
     const double ux = (jx + 0.5 * Fx) * ir, uy = (jy + 0.5 * Fy) * ir, uz = (jz + 0.5 * Fz) * ir;
     const double uu = ux * ux + uy * uy + uz * uz, uF = ux * Fx + uy * Fy + uz * Fz;
-    (relax<Q>(f, rho, ux, uy, uz, uu, uF, Fx, Fy, Fz), ...);
+    const double orho = omega * rho;
+    const double e0 = orho * (1.0 - 1.5 * uu) - 3.0 * a * uF, e2 = 4.5 * orho, e4 = 9.0 * a;
+    const double o1 = 3.0 * orho, o3 = 3.0 * a, keep = 1.0 - omega;
+    if constexpr (kTauOne) {
+      f[0] = kW[0] * e0;
+    } else {
+      f[0] = keep * f[0] + kW[0] * e0;
+    }
+    (relax_pair<K>(f, keep, e0, e2, e4, o1, o3, ux, uy, uz, Fx, Fy, Fz), ...);
   }
-  LBM_INLINE void operator()(double* f, double Fx, double Fy, double Fz) const { apply(f, Fx, Fy, Fz, Directions{}); }
+  LBM_INLINE void operator()(double* f, double Fx, double Fy, double Fz) const {
+    apply(f, Fx, Fy, Fz, Pairs{});
+  }
 };
 
 // ESPResSo's MRT with default bulk and ghost relaxation as a regularised scheme (section 1):
 // gs = 1 - 1/tau relaxes the traceless non-equilibrium stress, the trace is dropped, as = 1 - 1/(2 tau).
+// Rebuilt per pair of opposite directions: f_+-c = w (even +- odd) with even = rho + 4.5 (c.S.c - tr S / 3)
+// and odd = 3 c.j*.
 struct Regularized {
   double gs, as;
-  template <std::size_t Q>
-  LBM_INLINE static void rebuild(double* f, double rho, double jsx, double jsy, double jsz, double sxx, double syy,
-                             double szz, double sxy, double sxz, double syz, double trs) {
-    constexpr int X = kCx[Q], Y = kCy[Q], Z = kCz[Q];
-    const double ss = csc<X, Y, Z>(sxx, syy, szz, sxy, sxz, syz) - trs;
-    f[Q] = kW[Q] * (rho + 3.0 * cdot<X, Y, Z>(jsx, jsy, jsz) + 4.5 * ss);
+  template <std::size_t K>
+  LBM_INLINE static void rebuild_pair(double* f, double rho, double jsx, double jsy, double jsz, double sxx,
+                                      double syy, double szz, double sxy, double sxz, double syz, double trs) {
+    constexpr int q = 2 * static_cast<int>(K) + 1, qb = q + 1;
+    static_assert(opposite(q) == qb);
+    constexpr int X = kCx[q], Y = kCy[q], Z = kCz[q];
+    const double even = kW[q] * (rho + 4.5 * (csc<X, Y, Z>(sxx, syy, szz, sxy, sxz, syz) - trs));
+    const double odd = kW[q] * 3.0 * cdot<X, Y, Z>(jsx, jsy, jsz);
+    f[q] = even + odd;
+    f[qb] = even - odd;
   }
-  template <std::size_t... Q>
-  LBM_INLINE void apply(double* f, double Fx, double Fy, double Fz, std::index_sequence<Q...> d) const {
-    const double rho = sum(f, d);
-    const double jx = moment<kCx>(f, d), jy = moment<kCy>(f, d), jz = moment<kCz>(f, d);
-    const double pxx = square_moment<kCx>(f, d), pyy = square_moment<kCy>(f, d), pzz = square_moment<kCz>(f, d);
-    const double pxy = cross_moment<kCx, kCy>(f, d), pxz = cross_moment<kCx, kCz>(f, d), pyz = cross_moment<kCy, kCz>(f, d);
+  template <std::size_t... K>
+  LBM_INLINE void apply(double* f, double Fx, double Fy, double Fz, std::index_sequence<K...> k) const {
+    const PairSums p = pair_sums(f, k);
+    const double rho = f[0] + pair_total(p.s, k);
+    const double jx = pair_moment<kCx>(p.d, k), jy = pair_moment<kCy>(p.d, k), jz = pair_moment<kCz>(p.d, k);
+    const double pxx = pair_square<kCx>(p.s, k), pyy = pair_square<kCy>(p.s, k), pzz = pair_square<kCz>(p.s, k);
+    const double pxy = pair_cross<kCx, kCy>(p.s, k), pxz = pair_cross<kCx, kCz>(p.s, k), pyz = pair_cross<kCy, kCz>(p.s, k);
     const double ir = 1.0 / rho;
     const double ux = (jx + 0.5 * Fx) * ir, uy = (jy + 0.5 * Fy) * ir, uz = (jz + 0.5 * Fz) * ir;
     const double r3 = rho / 3.0;
@@ -156,9 +203,10 @@ struct Regularized {
     const double sxz = rho * ux * uz + gs * nxz + as * (ux * Fz + uz * Fx);
     const double syz = rho * uy * uz + gs * nyz + as * (uy * Fz + uz * Fy);
     const double trs = (sxx + syy + szz) / 3.0;
-    (rebuild<Q>(f, rho, jx + Fx, jy + Fy, jz + Fz, sxx, syy, szz, sxy, sxz, syz, trs), ...);
+    f[0] = kW[0] * (rho - 4.5 * trs);
+    (rebuild_pair<K>(f, rho, jx + Fx, jy + Fy, jz + Fz, sxx, syy, szz, sxy, sxz, syz, trs), ...);
   }
-  LBM_INLINE void operator()(double* f, double Fx, double Fy, double Fz) const { apply(f, Fx, Fy, Fz, Directions{}); }
+  LBM_INLINE void operator()(double* f, double Fx, double Fy, double Fz) const { apply(f, Fx, Fy, Fz, Pairs{}); }
 };
 
 constexpr std::size_t kParallelNodes = std::size_t{1} << 15;
@@ -307,13 +355,17 @@ LBM_INLINE void process_rows_impl(const StepArgs& a, int row0, int row1, const C
 #define BENDLAB_LBM_CLONES
 #endif
 
-BENDLAB_LBM_CLONES void process_rows_bgk(const StepArgs& a, int row0, int row1, const Bgk& c) {
+BENDLAB_LBM_CLONES void process_rows_bgk(const StepArgs& a, int row0, int row1, const Bgk<false>& c) {
+  process_rows_impl(a, row0, row1, c);
+}
+BENDLAB_LBM_CLONES void process_rows_bgk1(const StepArgs& a, int row0, int row1, const Bgk<true>& c) {
   process_rows_impl(a, row0, row1, c);
 }
 BENDLAB_LBM_CLONES void process_rows_reg(const StepArgs& a, int row0, int row1, const Regularized& c) {
   process_rows_impl(a, row0, row1, c);
 }
-void process_rows(const StepArgs& a, int row0, int row1, const Bgk& c) { process_rows_bgk(a, row0, row1, c); }
+void process_rows(const StepArgs& a, int row0, int row1, const Bgk<false>& c) { process_rows_bgk(a, row0, row1, c); }
+void process_rows(const StepArgs& a, int row0, int row1, const Bgk<true>& c) { process_rows_bgk1(a, row0, row1, c); }
 void process_rows(const StepArgs& a, int row0, int row1, const Regularized& c) { process_rows_reg(a, row0, row1, c); }
 
 }  // namespace
@@ -415,8 +467,10 @@ void Lattice::step_layers(int j0, int j1) {
   if (j0 < 0 || j1 > config_.ny || j0 >= j1)
     throw Error(fmt::format("LBM step of layers [{}, {}) outside the lattice's 0..{}", j0, j1, config_.ny));
   const double tau = config_.tau;
-  if (collision_ == Collision::BGK) {
-    step_with(Bgk{1.0 / tau, 1.0 - 0.5 / tau}, j0, j1);
+  if (collision_ == Collision::BGK && tau == 1.0) {
+    step_with(Bgk<true>{1.0, 0.5}, j0, j1);
+  } else if (collision_ == Collision::BGK) {
+    step_with(Bgk<false>{1.0 / tau, 1.0 - 0.5 / tau}, j0, j1);
   } else {
     step_with(Regularized{1.0 - 1.0 / tau, 1.0 - 0.5 / tau}, j0, j1);
   }
