@@ -45,7 +45,7 @@ and whether it is done, resumes from a checkpoint or is still to run, and runs n
     /usr/bin/python3 scripts/shear_study.py --only e --list
 
 Every run is one `bendlab shear ... --no-plot` process whose output folder lies under --work
-(default results/shear_study). A run whose summary.json exists and matches the arguments is not
+(default studies/shear, kept in git: studies/README.md). A run whose summary.json exists and matches the arguments is not
 run again; a run that was interrupted continues from its checkpoint (--resume). Interrupting the
 study and starting it again with the same options therefore loses at most the work since the last
 checkpoint of each running run.
@@ -988,7 +988,8 @@ def main():
                     help="run only the runs of this part; e (5120 triangles, RKC) is run only when asked "
                          "for and writes its own section at the end of --doc, keeping the rest")
     ap.add_argument("--bendlab", default="build/release/bendlab", help="the bendlab binary")
-    ap.add_argument("--work", default="results/shear_study", help="folder of the runs (the cache)")
+    ap.add_argument("--work", default="studies/shear",
+                    help="folder of the runs (the cache; kept in git so that a study resumes on another machine)")
     ap.add_argument("--doc", default="docs/results/shear.md",
                     help="the document to write; its figures go to a folder of the same name without .md")
     ap.add_argument("--triangles", default="320,1280",
