@@ -248,3 +248,27 @@ TEST(Lattice, PaddedSlotsMatchThePlainLayout) {
     EXPECT_EQ(result[0], result[1]) << "tau " << tau;
   }
 }
+
+TEST(Lattice, ClearForceZeroesEveryNodeWritten) {
+  // clear_force zeroes only the nodes written since the last clear while they are few, and the
+  // whole field once they are many or after set_uniform_force: each way leaves no force behind.
+  Lattice L(box(8, 6, 5, 1.0, true, 0.01));
+  const auto all_zero = [&] {
+    for (std::size_t n = 0; n < L.num_nodes(); ++n)
+      if (L.force(n) != Vec3::Zero()) return false;
+    return true;
+  };
+  L.add_force(3, Vec3(1, 2, 3));
+  L.add_force(3, Vec3(1, 0, 0));
+  L.add_force(L.num_nodes() - 1, Vec3(0, 0, -1));
+  EXPECT_EQ(L.force(3), Vec3(2, 2, 3));
+  L.clear_force();
+  EXPECT_TRUE(all_zero());
+  for (std::size_t n = 0; n < L.num_nodes(); n += 2) L.add_force(n, Vec3(1e-3, 0, 0));  // more than n / 8
+  L.clear_force();
+  EXPECT_TRUE(all_zero());
+  L.set_uniform_force(Vec3(0, 1e-4, 0));
+  L.add_force(7, Vec3(1, 1, 1));
+  L.clear_force();
+  EXPECT_TRUE(all_zero());
+}

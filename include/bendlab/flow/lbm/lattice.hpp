@@ -99,13 +99,15 @@ class Lattice {
 
   /// The force density field (force per node) applied in the next step, Guo forcing. It is not
   /// reset by step(): velocity() uses it for the F/2 correction after the step (ESPResSo's order),
-  /// and the caller clears it before spreading new forces.
+  /// and the caller clears it before spreading new forces (only the nodes written since the last
+  /// clear, when they are few).
   void clear_force();
   void add_force(std::size_t node, const Vec3& F) {
     double* f = force_.data();
     f[node] += F.x();
     f[stride_ + node] += F.y();
     f[2 * stride_ + node] += F.z();
+    note_forced(node);
   }
   void set_uniform_force(const Vec3& F);
   Vec3 force(std::size_t node) const {
@@ -113,7 +115,6 @@ class Lattice {
     return {f[node], f[stride_ + node], f[2 * stride_ + node]};
   }
   /// Component d (0, 1, 2) of the force field, num_nodes() values.
-  double* force_data(int d) { return force_.data() + d * stride_; }
   const double* force_data(int d) const { return force_.data() + d * stride_; }
 
   /// One step: collide with the force field (Guo), stream, bounce back at the walls. OpenMP over
@@ -161,6 +162,20 @@ class Lattice {
   std::int64_t step_ = 0;
   AlignedDoubles f_;      // kQ slots of stride_ doubles
   AlignedDoubles force_;  // 3 components of stride_ doubles
+  // The nodes add_force wrote since the last clear_force, so that clearing the few nodes an
+  // immersed boundary touches does not sweep the whole field every step; everywhere once the
+  // list would exceed num_nodes() / 8 or after set_uniform_force.
+  std::vector<std::size_t> forced_;
+  bool force_everywhere_ = false;
+  void note_forced(std::size_t node) {
+    if (force_everywhere_) return;
+    if (forced_.size() >= n_ / 8) {
+      force_everywhere_ = true;
+      forced_.clear();
+      return;
+    }
+    forced_.push_back(node);
+  }
 };
 
 }  // namespace bendlab::lbm
