@@ -2,8 +2,8 @@
 """The paper's figure 15 (LBM beside BIM) from `bendlab shear --solver lbm` runs, with the
 resolution study of shared/spec/LBM_IBM.md section 5.
 
-    /usr/bin/python3 scripts/lbm_study.py [--radii 6,8,10] [--full] [--t-end T] [--jobs N]
-                                          [--measure-steps N] [--only-measure] [--no-runs]
+    /usr/bin/python3 scripts/lbm_study.py [--radii 6,8,10] [--full] [--t-end T]
+                                          [--measure-steps N] [--only-measure] [--no-runs] [--no-bim]
                                           [--bim-work DIR] [--work DIR] [--doc FILE] [--bendlab PATH]
 
 Cases: (G, kappa_b_hat) = (0.05, 0.0375) and (0.2, 0.15) with the paper's LBM methods A and B
