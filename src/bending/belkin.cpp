@@ -191,7 +191,7 @@ __attribute__((always_inline)) inline void grid_sum_body(const GridInput& in, co
 // Compiled for AVX-512, AVX2+FMA and baseline x86-64 and picked at run time (as the boundary
 // integral's kernel, stokes_single_layer.cpp).
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
-#define BENDLAB_KERNEL_CLONES __attribute__((target_clones("avx512f", "avx2,fma", "default")))
+#define BENDLAB_KERNEL_CLONES __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
 #else
 #define BENDLAB_KERNEL_CLONES
 #endif

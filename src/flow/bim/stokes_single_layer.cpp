@@ -222,7 +222,7 @@ Vec3 polar_integral(const Vec3& x0, const Vec3& x1, const Vec3& x2, const Vec3& 
 // same binary runs everywhere and uses 8- or 4-wide doubles where the processor has them. The
 // file is built with -fno-math-errno (so that sqrt vectorises) and -ffp-contract=fast (FMA).
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
-__attribute__((target_clones("avx512f", "avx2,fma", "default")))
+__attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
 #endif
 void regular_sum(double xi, double yi, double zi, const double* __restrict qx, const double* __restrict qy,
                  const double* __restrict qz, const double* __restrict fx, const double* __restrict fy,
@@ -245,7 +245,7 @@ void regular_sum(double xi, double yi, double zi, const double* __restrict qx, c
 // Chebyshev moments M_beta += sum_k T_beta(s_k) F_k, s_k = S (y_k - centre) (S column-major 3 x 3),
 // beta = (a, b, c), a + b + c <= q, in the order of tree_basis_ (a, then b, then c ascending).
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
-__attribute__((target_clones("avx512f", "avx2,fma", "default")))
+__attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
 #endif
 void chebyshev_moments(const double* S, const double* centre, int q, const double* sx, const double* sy,
                        const double* sz, const double* sfx, const double* sfy, const double* sfz, int count,
@@ -278,7 +278,7 @@ void chebyshev_moments(const double* S, const double* centre, int q, const doubl
 
 // Proxy weights W_m = sum_beta C(beta, m) M_beta for m < nm (C row-major nm x nm), zero up to padded.
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
-__attribute__((target_clones("avx512f", "avx2,fma", "default")))
+__attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
 #endif
 void lagrange_weights(const double* C, const double* mx, const double* my, const double* mz, int nm, int padded,
                       double* __restrict wx, double* __restrict wy, double* __restrict wz) {
