@@ -46,8 +46,9 @@
 // the run's end and the half-space test as a mask) so that they vectorise (AVX-512, AVX2 or
 // baseline, chosen at run time):
 // - all: blocks of 16, exp by a polynomial within an ulp of std::exp (measured over [0, 80]).
-// - grid: blocks of 8 (one AVX-512 register; the runs are short), the exponential in base 2 by a
-//   polynomial of degree 9 (relative error within 2.3e-14), the half-space test only for vertices
+// - grid: blocks of one vector register (8 with AVX-512, else 4: the runs are short), the
+//   exponential in base 2 by a polynomial of degree 9 evaluated by Estrin's scheme (relative
+//   error within 2.3e-14), the half-space test only for vertices
 //   whose ball crosses the plane (elsewhere every point of the ball passes it: the same terms),
 //   and for Lap x the differences p - x_i the distance is made of.
 // One Method D evaluation on the red blood cell, one thread, processor time on the shared 2-core
@@ -62,6 +63,10 @@
 // agrees: D / C 10 / 9.0 / 7.1 (3.97 / 15.6 / 67.0 ms against 0.39 / 1.73 / 9.49 ms). The parts of
 // D at 81920 triangles (belkin_neighbours stages 81920, memory kept): mesh geometry 0.008 s (as
 // C's), set-up 0.013 s, Lap x 0.022 s, Lap H 0.020 s.
+// On an AMD EPYC with AVX2 and no AVX-512 (4 lanes), same command: D 0.0096 / 0.034 / 0.134 s
+// (3.3-3.8 us per vertex), C 0.0005 / 0.0026 / 0.0106 s, D / C 18 / 13 / 12.7; stages at 81920:
+// geometry 0.009 s, set-up 0.016 s, Lap x 0.058 s, Lap H 0.055 s (the kernel there costs 2.6 times
+// the AVX-512 machine's; before Estrin's scheme, 4 lanes and FMA: Lap x 0.084 s, Lap H 0.078 s).
 // Without the two variables the same run is not a measure of D: first touch of fresh memory costs
 // 17 us per 4 KiB page on that virtual machine, and what glibc hands back between evaluations
 // depends on what the other method freed. Measured there: with this code C 0.041-0.060 s after D
