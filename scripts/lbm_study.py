@@ -352,11 +352,12 @@ def main():
         return
 
     if not a.no_runs:
-        for r in sorted(runs, key=lambda r: (r.steps() * math.prod(r.nodes()), r.name)):
-            execute(r, work / r.name, bendlab)
+        # The BIM runs first: minutes each, and the column every LBM result is read against.
         if not a.no_bim:
             for b in bim_runs:
                 execute(b, bim_work / b.name, bendlab)
+        for r in sorted(runs, key=lambda r: (r.steps() * math.prod(r.nodes()), r.name)):
+            execute(r, work / r.name, bendlab)
     write_doc(a, runs, bim_runs, work, bim_work, cost, projected, totals)
 
 
