@@ -201,32 +201,22 @@ BENDLAB_KERNEL_CLONES void run_sum1(const KernelInput& in, const int* runs, int 
 BENDLAB_KERNEL_CLONES void run_sum3(const KernelInput& in, const int* runs, int nruns, double* acc) {
   run_sum_body<3>(in, runs, nruns, acc);
 }
-// The grid kernels in blocks of 8 lanes (used where AVX-512 is available) and of 4.
+// The grid kernels in blocks of 8 lanes (used where AVX-512 is available) and of 4: each a
+// function of its own, so that target_clones compiles it for every instruction set.
 using GridKernel = void (*)(const GridInput&, const int*, int, double*);
-BENDLAB_KERNEL_CLONES void grid_sum_scalar8(const GridInput& in, const int* runs, int nruns, double* acc) {
-  grid_sum_body<Field::scalar, false, 8>(in, runs, nruns, acc);
-}
-BENDLAB_KERNEL_CLONES void grid_sum_scalar_plane8(const GridInput& in, const int* runs, int nruns, double* acc) {
-  grid_sum_body<Field::scalar, true, 8>(in, runs, nruns, acc);
-}
-BENDLAB_KERNEL_CLONES void grid_sum_positions8(const GridInput& in, const int* runs, int nruns, double* acc) {
-  grid_sum_body<Field::positions, false, 8>(in, runs, nruns, acc);
-}
-BENDLAB_KERNEL_CLONES void grid_sum_positions_plane8(const GridInput& in, const int* runs, int nruns, double* acc) {
-  grid_sum_body<Field::positions, true, 8>(in, runs, nruns, acc);
-}
-BENDLAB_KERNEL_CLONES void grid_sum_scalar4(const GridInput& in, const int* runs, int nruns, double* acc) {
-  grid_sum_body<Field::scalar, false, 4>(in, runs, nruns, acc);
-}
-BENDLAB_KERNEL_CLONES void grid_sum_scalar_plane4(const GridInput& in, const int* runs, int nruns, double* acc) {
-  grid_sum_body<Field::scalar, true, 4>(in, runs, nruns, acc);
-}
-BENDLAB_KERNEL_CLONES void grid_sum_positions4(const GridInput& in, const int* runs, int nruns, double* acc) {
-  grid_sum_body<Field::positions, false, 4>(in, runs, nruns, acc);
-}
-BENDLAB_KERNEL_CLONES void grid_sum_positions_plane4(const GridInput& in, const int* runs, int nruns, double* acc) {
-  grid_sum_body<Field::positions, true, 4>(in, runs, nruns, acc);
-}
+#define BENDLAB_GRID_KERNEL(name, kind, plane, lanes)                                            \
+  BENDLAB_KERNEL_CLONES void name(const GridInput& in, const int* runs, int nruns, double* acc) { \
+    grid_sum_body<kind, plane, lanes>(in, runs, nruns, acc);                                     \
+  }
+BENDLAB_GRID_KERNEL(grid_sum_scalar8, Field::scalar, false, 8)
+BENDLAB_GRID_KERNEL(grid_sum_scalar_plane8, Field::scalar, true, 8)
+BENDLAB_GRID_KERNEL(grid_sum_positions8, Field::positions, false, 8)
+BENDLAB_GRID_KERNEL(grid_sum_positions_plane8, Field::positions, true, 8)
+BENDLAB_GRID_KERNEL(grid_sum_scalar4, Field::scalar, false, 4)
+BENDLAB_GRID_KERNEL(grid_sum_scalar_plane4, Field::scalar, true, 4)
+BENDLAB_GRID_KERNEL(grid_sum_positions4, Field::positions, false, 4)
+BENDLAB_GRID_KERNEL(grid_sum_positions_plane4, Field::positions, true, 4)
+#undef BENDLAB_GRID_KERNEL
 // [field][plane]: field 0 scalar, 1 positions; the block width of the processor's widest vectors.
 struct GridKernels {
   GridKernel k[2][2];
