@@ -4,7 +4,7 @@ resolution study of shared/spec/LBM_IBM.md section 5.
 
     /usr/bin/python3 scripts/lbm_study.py [--radii 6,8,10] [--full] [--t-end T]
                                           [--measure-steps N] [--only-measure] [--no-runs] [--no-bim] [--jobs N]
-                                          [--bim-work DIR] [--work DIR] [--doc FILE] [--bendlab PATH]
+                                          [--inertia-radius R] [--bim-work DIR] [--work DIR] [--doc FILE] [--bendlab PATH]
 
 Cases: (G, kappa_b_hat) = (0.05, 0.0375) and (0.2, 0.15) with the paper's LBM methods A and B
 (figure 15), and kappa_b_hat = 0 at the same G, each at R = 6, 8, 10 lattice units (--radii), with
@@ -14,7 +14,9 @@ R = 13.5, 5120 triangles, box 9.5 R x 9.5 R x 19 R (128 x 128 x 256 nodes).
 
 For each case the steady D (gamma t in [5, 10]) is fitted as D(R) = D_inf + a / R^p (three radii
 determine D_inf, a and p; with two only p = 1 is assumed), and the smallest R within 2 % of D_inf
-is named (the spec's protocol). The BIM values beside them are read from the BIM runs with the
+is named (the spec's protocol), and D_inf is checked against the BIM: within 3 %. The inertia check
+of the same protocol runs method A at G = 0.2, kappa_b_hat = 0.15 once more with the shear rate
+halved (Re = 0.1) at --inertia-radius (default the middle radius; 0 leaves it out). The BIM values beside them are read from the BIM runs with the
 same G, kappa_b_hat, method and 1280 triangles in --bim-work (default studies/shear, the
 folder of scripts/shear_study.py); missing BIM runs are run there with scripts/shear_study.py's
 naming, so the two studies share them.
@@ -27,7 +29,11 @@ cached and resumable as in scripts/shear_study.py: a run whose summary.json matc
 again, an interrupted run continues from its checkpoint (--resume). --no-runs writes the document
 from what is in the work folder (finished runs; running or missing ones are listed as such).
 
-Writes --doc (default docs/results/lbm.md) and its PNGs (docs/results/lbm/).
+--jobs N runs N runs at once (each its own process; give them OMP_NUM_THREADS=1 on a machine of N
+cores): figure 15's methods first, then kappa_b_hat = 0, the inertia check last.
+
+Writes --doc (default docs/results/lbm.md) and its PNGs (docs/results/lbm/): the steady D of every
+case and radius with D_inf and the BIM, D against 1 / R, D against gamma t and the inertia check.
 """
 import argparse
 import csv
@@ -71,14 +77,17 @@ class LbmRun:
     triangles: int
     box: tuple
     t_end: float
+    reynolds: float = REYNOLDS
 
     @property
     def name(self):
         return (f"lbm_{self.method}_R{fmt_g(self.radius)}_mt1-{self.triangles}_G{fmt_g(self.G)}"
-                f"_kb{fmt_g(self.kappa_b)}_t{fmt_g(self.t_end)}")
+                f"_kb{fmt_g(self.kappa_b)}_t{fmt_g(self.t_end)}"
+                + ("" if self.reynolds == REYNOLDS else f"_Re{fmt_g(self.reynolds)}"))
 
     def label(self):
-        return f"LBM method {self.method:>4}, R = {fmt_g(self.radius):>4}, G = {fmt_g(self.G)}, kB_hat = {fmt_g(self.kappa_b)}"
+        return (f"LBM method {self.method:>4}, R = {fmt_g(self.radius):>4}, G = {fmt_g(self.G)}, kB_hat = {fmt_g(self.kappa_b)}"
+                + ("" if self.reynolds == REYNOLDS else f", Re = {fmt_g(self.reynolds)}"))
 
     def nodes(self):
         return [round(b * self.radius) for b in self.box]
@@ -86,7 +95,7 @@ class LbmRun:
     def shear_rate(self):
         """gamma in lattice units, as lbm::capsule_run_parameters computes it."""
         nu = (TAU - 0.5) / 3
-        v = REYNOLDS * nu / self.radius
+        v = self.reynolds * nu / self.radius
         return 2 * v / self.nodes()[2]
 
     def steps(self):
@@ -96,7 +105,7 @@ class LbmRun:
         return ["shear", "--solver", "lbm", "--method", self.method, "--mesh", f"mt1:{self.triangles}",
                 "--G", fmt_g(self.G), "--kappa-b-hat", fmt_g(self.kappa_b),
                 "--radius-lu", fmt_g(self.radius), "--box", ",".join(fmt_g(b) for b in self.box),
-                "--tau", fmt_g(TAU), "--reynolds", fmt_g(REYNOLDS),
+                "--tau", fmt_g(TAU), "--reynolds", fmt_g(self.reynolds),
                 "--t-end", fmt_g(self.t_end if t_end is None else t_end), "--out", str(out), "--no-plot"]
 
 
@@ -145,6 +154,7 @@ def lbm_matches(args, run):
         return (args.get("solver") == "lbm" and args.get("method") == run.method
                 and args.get("mesh") == f"mt1:{run.triangles}" and close(args.get("G"), run.G)
                 and close(args.get("kappa_b_hat"), run.kappa_b) and close(args.get("radius_lu"), run.radius)
+                and close(args.get("reynolds", REYNOLDS), run.reynolds)
                 and all(close(a, b) for a, b in zip(args.get("box", []), run.box)))
     except (TypeError, ValueError, AttributeError):
         return False
@@ -305,6 +315,9 @@ def main():
     ap.add_argument("--bim-work", default=str(ROOT / "studies/shear"),
                     help="folder of the BIM runs, scripts/shear_study.py's")
     ap.add_argument("--doc", default=str(ROOT / "docs/results/lbm.md"))
+    ap.add_argument("--inertia-radius", type=float, default=None,
+                    help="radius of the inertia check (method A, G = 0.2, kB_hat = 0.15 with Re halved; "
+                         "default the middle of --radii, 0: none)")
     ap.add_argument("--jobs", type=int, default=1,
                     help="runs in parallel (default 1); run each with OMP_NUM_THREADS=1 when more than one")
     a = ap.parse_args()
@@ -323,6 +336,11 @@ def main():
         if a.full:
             runs += [LbmRun(m, G, kb, FULL_R, 5120, FULL_BOX, a.t_end) for m in METHODS]
             runs.append(LbmRun("none", G, 0.0, FULL_R, 5120, FULL_BOX, a.t_end))
+    # The spec's inertia check (LBM_IBM.md section 5): the shear rate halved (Re and Re_p halved) at
+    # one radius; D should not move.
+    inertia_radius = a.inertia_radius if a.inertia_radius is not None else sorted(radii)[len(radii) // 2]
+    if inertia_radius > 0:
+        runs.append(LbmRun("A", 0.2, 0.15, inertia_radius, 1280, BOX, a.t_end, REYNOLDS / 2))
     bim_runs = sorted({BimRun(r.method, r.G, r.kappa_b, a.t_end) for r in runs}, key=lambda b: b.name)
 
     # Cost per step, one probe per distinct lattice (the fluid dominates; method A's forces stand in).
@@ -359,12 +377,13 @@ def main():
     if not a.no_runs:
         # The BIM runs first: minutes each, and the column every LBM result is read against.
         # Each run has its own folder, so runs in parallel share nothing. Figure 15's methods go
-        # first (in METHODS order, kappa_b = 0 last), the cheapest first within each.
+        # first (in METHODS order, kappa_b = 0 last), the cheapest first within each; the inertia
+        # check last.
         with ThreadPoolExecutor(max_workers=a.jobs) as pool:
             if not a.no_bim:
                 list(pool.map(lambda b: execute(b, bim_work / b.name, bendlab), bim_runs))
             rank = {m: i for i, m in enumerate(METHODS)}
-            ordered = sorted(runs, key=lambda r: (rank.get(r.method, len(METHODS)),
+            ordered = sorted(runs, key=lambda r: (r.reynolds != REYNOLDS, rank.get(r.method, len(METHODS)),
                                                   r.steps() * math.prod(r.nodes()), r.name))
             list(pool.map(lambda r: execute(r, work / r.name, bendlab), ordered))
     write_doc(a, runs, bim_runs, work, bim_work, cost, projected, totals)
@@ -424,18 +443,22 @@ def write_doc(a, runs, bim_runs, work, bim_work, cost, projected, totals):
     L += ["", f"Projected time of the unfinished LBM runs, one after another: **{total / 3600:.1f} h** of wall time "
               f"at the measured load, **{total_cpu / 3600:.1f} h** of CPU time. Larger lattices are scaled from the",
           "largest measured one by node count.", ""]
-    # Results
+    # Results (the inertia check has a table of its own below)
+    main_runs = [r for r in runs if r.reynolds == REYNOLDS]
+    radii_all = sorted({r.radius for r in main_runs})
     L += ["## Steady deformation", "",
-          "| G | kB_hat | method | " + " | ".join(f"D (R = {fmt_g(R)})" for R in sorted({r.radius for r in runs}))
-          + " | D_inf (p) | smallest R within 2 % | BIM 1280 |",
-          "|---|---|---|" + "---|" * (len({r.radius for r in runs}) + 3)]
-    cases = sorted({(r.G, r.kappa_b, r.method) for r in runs})
-    figs = []
+          "D_inf from D(R) = D_inf + a / R^p: through the last three radii (p fitted), or with p = 1 through",
+          "two. The check of the issue: D_inf within 3 % of the project's BIM at 1280 triangles.", "",
+          "| G | kB_hat | method | " + " | ".join(f"D (R = {fmt_g(R)})" for R in radii_all)
+          + " | D_inf (p) | smallest R within 2 % | BIM 1280 | D_inf / BIM - 1 | within 3 % |",
+          "|---|---|---|" + "---|" * (len(radii_all) + 5)]
+    cases = sorted({(r.G, r.kappa_b, r.method) for r in main_runs})
+    figs, fits = [], {}
     for (G, kb, m) in cases:
-        rs = sorted([r for r in runs if (r.G, r.kappa_b, r.method) == (G, kb, m) and r.triangles == 1280],
+        rs = sorted([r for r in main_runs if (r.G, r.kappa_b, r.method) == (G, kb, m) and r.triangles == 1280],
                     key=lambda r: r.radius)
         cells, pts = [], []
-        for r in sorted([r for r in runs if (r.G, r.kappa_b, r.method) == (G, kb, m)], key=lambda r: r.radius):
+        for r in sorted([r for r in main_runs if (r.G, r.kappa_b, r.method) == (G, kb, m)], key=lambda r: r.radius):
             s = finished_summary(work / r.name, r)
             cells.append(f"{s['D_steady']:.4f}" if s and s.get("D_steady") is not None else "-")
             if s and s.get("D_steady") is not None and r in rs:
@@ -448,12 +471,20 @@ def write_doc(a, runs, bim_runs, work, bim_work, cost, projected, totals):
             within = fmt_g(min(ok)) if ok else "none"
         b = BimRun(m, G, kb, a.t_end)
         bs = finished_summary(bim_work / b.name, b)
-        bim = f"{bs['D_steady']:.4f}" if bs and bs.get("D_steady") is not None else "not run"
-        L.append(f"| {fmt_g(G)} | {fmt_g(kb)} | {m} | " + " | ".join(cells) + f" | {fit_cell} | {within} | {bim} |")
+        bim_d = bs.get("D_steady") if bs else None
+        bim = f"{bim_d:.4f}" if bim_d is not None else "not run"
+        dev = check = "-"
+        if fit and bim_d:
+            rel_dev = fit[0] / bim_d - 1
+            dev = f"{100 * rel_dev:+.1f} %"
+            check = ("yes" if abs(rel_dev) <= 0.03 else "**no**") + ("" if len(pts) >= 3 else " (p = 1 assumed)")
+        fits[(G, kb, m)] = (pts, fit, bim_d)
+        L.append(f"| {fmt_g(G)} | {fmt_g(kb)} | {m} | " + " | ".join(cells)
+                 + f" | {fit_cell} | {within} | {bim} | {dev} | {check} |")
         # figure: D(gamma t), LBM at each R beside the BIM
         fig, ax = plt.subplots(figsize=(5.5, 3.6))
         any_line = False
-        for r in sorted([r for r in runs if (r.G, r.kappa_b, r.method) == (G, kb, m)], key=lambda r: r.radius):
+        for r in sorted([r for r in main_runs if (r.G, r.kappa_b, r.method) == (G, kb, m)], key=lambda r: r.radius):
             ser = read_series(work / r.name)
             if ser is not None:
                 ax.plot(ser["gamma_t"], ser["D"], label=f"LBM R = {fmt_g(r.radius)}")
@@ -472,6 +503,54 @@ def write_doc(a, runs, bim_runs, work, bim_work, cost, projected, totals):
             fig.savefig(png, dpi=110)
             figs.append(f"![D against gamma t, G = {fmt_g(G)}, kB_hat = {fmt_g(kb)}, method {m}](lbm/{png.name})")
         plt.close(fig)
+    # Convergence in R: D_steady against 1 / R with the fit and the BIM value, one plot per G.
+    conv = []
+    for G in sorted({c[0] for c in cases}):
+        fig, ax = plt.subplots(figsize=(5.5, 3.6))
+        drawn = False
+        for i, (g, kb, m) in enumerate(c for c in cases if c[0] == G):
+            pts, fit, bim_d = fits[(g, kb, m)]
+            if not pts:
+                continue
+            colour = f"C{i}"
+            x = [1 / R for R, _ in pts]
+            ax.plot(x, [D for _, D in pts], "o", color=colour, label=f"{m}, kB_hat = {fmt_g(kb)}")
+            if fit:
+                xs = np.linspace(0, max(x), 50)
+                ax.plot(xs, fit[0] + fit[1] * np.power(np.maximum(xs, 1e-12), fit[2]), "-", color=colour, lw=0.8)
+            if bim_d:
+                ax.plot([0], [bim_d], "s", mfc="none", color=colour, ms=8)
+            drawn = True
+        if drawn:
+            ax.set_xlim(left=-0.006)
+            ax.set_xlabel("1 / R (lattice units)")
+            ax.set_ylabel("steady D")
+            ax.set_title(f"G = {fmt_g(G)}: LBM (dots), fit (lines), BIM 1280 (squares at 1/R = 0)", fontsize=9)
+            ax.legend(fontsize=8)
+            fig.tight_layout()
+            png = figdir / f"convergence_G{fmt_g(G)}.png"
+            fig.savefig(png, dpi=110)
+            conv.append(f"![steady D against 1 / R, G = {fmt_g(G)}](lbm/{png.name})")
+        plt.close(fig)
+    if conv:
+        L += ["", "## Convergence in R", ""] + [c + "\n" for c in conv]
+    # Inertia check
+    inertia = [r for r in runs if r.reynolds != REYNOLDS]
+    if inertia:
+        L += ["", "## Inertia check", "",
+              "The spec's protocol (LBM_IBM.md section 5): the shear rate halved at one radius (Re and the",
+              "particle Reynolds number halved, everything else equal); D should not move.", "",
+              f"| G | kB_hat | method | R | D (Re = {fmt_g(REYNOLDS)}) | D (Re halved) | relative change |",
+              "|---|---|---|---|---|---|---|"]
+        for r in inertia:
+            base = LbmRun(r.method, r.G, r.kappa_b, r.radius, r.triangles, r.box, r.t_end)
+            s0, s1 = finished_summary(work / base.name, base), finished_summary(work / r.name, r)
+            d0 = s0.get("D_steady") if s0 else None
+            d1 = s1.get("D_steady") if s1 else None
+            L.append(f"| {fmt_g(r.G)} | {fmt_g(r.kappa_b)} | {r.method} | {fmt_g(r.radius)} | "
+                     + (f"{d0:.4f}" if d0 is not None else "-") + " | "
+                     + (f"{d1:.4f} (Re = {fmt_g(r.reynolds)})" if d1 is not None else "-") + " | "
+                     + (f"{100 * (d1 / d0 - 1):+.2f} %" if d0 and d1 is not None else "-") + " |")
     L += ["", "A dash: the run has not finished. Partial runs (a time series but no summary) are drawn as far as",
           f"they got. The BIM column reads `{rel(bim_work)}` (scripts/shear_study.py's runs).", ""]
     L += ["## D against gamma t", ""] + [f + "\n" for f in figs] if figs else []
