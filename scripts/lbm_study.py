@@ -397,6 +397,17 @@ def rel(path):
         return str(path)
 
 
+def save_figure(fig, ax, xlabel, ylabel, title, png, alt, title_size=None):
+    """Labels, legend and PNG of one figure; returns its Markdown line (relative to the document)."""
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title, fontsize=title_size)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(png, dpi=110)
+    return f"![{alt}](lbm/{png.name})"
+
+
 def write_doc(a, runs, bim_runs, work, bim_work, cost, projected, totals):
     total, total_cpu = totals
     doc = Path(a.doc)
@@ -494,14 +505,9 @@ def write_doc(a, runs, bim_runs, work, bim_work, cost, projected, totals):
             ax.plot(ser["gamma_t"], ser["D"], "k--", label="BIM 1280")
             any_line = True
         if any_line:
-            ax.set_xlabel("gamma t")
-            ax.set_ylabel("D")
-            ax.set_title(f"G = {fmt_g(G)}, kB_hat = {fmt_g(kb)}, method {m}")
-            ax.legend(fontsize=8)
-            fig.tight_layout()
-            png = figdir / f"D_G{fmt_g(G)}_kb{fmt_g(kb)}_{m}.png"
-            fig.savefig(png, dpi=110)
-            figs.append(f"![D against gamma t, G = {fmt_g(G)}, kB_hat = {fmt_g(kb)}, method {m}](lbm/{png.name})")
+            figs.append(save_figure(fig, ax, "gamma t", "D", f"G = {fmt_g(G)}, kB_hat = {fmt_g(kb)}, method {m}",
+                                    figdir / f"D_G{fmt_g(G)}_kb{fmt_g(kb)}_{m}.png",
+                                    f"D against gamma t, G = {fmt_g(G)}, kB_hat = {fmt_g(kb)}, method {m}"))
         plt.close(fig)
     # Convergence in R: D_steady against 1 / R with the fit and the BIM value, one plot per G.
     conv = []
@@ -523,14 +529,10 @@ def write_doc(a, runs, bim_runs, work, bim_work, cost, projected, totals):
             drawn = True
         if drawn:
             ax.set_xlim(left=-0.006)
-            ax.set_xlabel("1 / R (lattice units)")
-            ax.set_ylabel("steady D")
-            ax.set_title(f"G = {fmt_g(G)}: LBM (dots), fit (lines), BIM 1280 (squares at 1/R = 0)", fontsize=9)
-            ax.legend(fontsize=8)
-            fig.tight_layout()
-            png = figdir / f"convergence_G{fmt_g(G)}.png"
-            fig.savefig(png, dpi=110)
-            conv.append(f"![steady D against 1 / R, G = {fmt_g(G)}](lbm/{png.name})")
+            conv.append(save_figure(fig, ax, "1 / R (lattice units)", "steady D",
+                                    f"G = {fmt_g(G)}: LBM (dots), fit (lines), BIM 1280 (squares at 1/R = 0)",
+                                    figdir / f"convergence_G{fmt_g(G)}.png", f"steady D against 1 / R, G = {fmt_g(G)}",
+                                    title_size=9))
         plt.close(fig)
     if conv:
         L += ["", "## Convergence in R", ""] + [c + "\n" for c in conv]
