@@ -21,9 +21,10 @@ same G, kappa_b_hat, method and 1280 triangles in --bim-work (default studies/sh
 folder of scripts/shear_study.py); missing BIM runs are run there with scripts/shear_study.py's
 naming, so the two studies share them.
 
-Cost: before the runs, the two smallest radii are timed for --measure-steps lattice steps (default
-300; cached in <work>/cost.json, with the load average before and after), larger lattices are
-scaled from the largest measured one by node count (the fluid dominates), and the script prints
+Cost: before the runs, the two smallest radii (and with --full the paper's lattice) are timed for
+--measure-steps lattice steps (default 300; cached in <work>/cost.json, with the load average before
+and after), other lattices are scaled by node count from the largest measured one with as many
+triangles (the fluid dominates), and the script prints
 the seconds per step and the projected wall time of every run and of the whole study. --only-measure stops there. Runs are
 cached and resumable as in scripts/shear_study.py: a run whose summary.json matches is not run
 again, an interrupted run continues from its checkpoint (--resume). --no-runs writes the document
@@ -90,7 +91,7 @@ class LbmRun:
                 + ("" if self.reynolds == REYNOLDS else f", Re = {fmt_g(self.reynolds)}"))
 
     def nodes(self):
-        return [round(b * self.radius) for b in self.box]
+        return [math.floor(b * self.radius + 0.5) for b in self.box]  # as the solver rounds (half up)
 
     def shear_rate(self):
         """gamma in lattice units, as lbm::capsule_run_parameters computes it."""
@@ -258,7 +259,8 @@ def seconds_per_step(run, cost, key="seconds_per_step"):
     cost = {k: c for k, c in cost.items() if key in c}
     if not cost:
         return None, "no measurement"
-    ref = max(cost.values(), key=lambda c: math.prod(c["nodes"]))
+    same = {k: c for k, c in cost.items() if c.get("triangles") == run.triangles}
+    ref = max((same or cost).values(), key=lambda c: math.prod(c["nodes"]))
     return ref[key] * math.prod(run.nodes()) / math.prod(ref["nodes"]), \
         f"scaled from R = {fmt_g(ref['radius'])} by node count"
 
@@ -346,7 +348,7 @@ def main():
     # Cost per step, one probe per distinct lattice (the fluid dominates; method A's forces stand in).
     probes = {}
     for r in runs:
-        if r.method == "A" and cost_key(r) not in probes and r.radius in radii[:2]:
+        if r.method == "A" and cost_key(r) not in probes and (r.radius in radii[:2] or r.box == FULL_BOX):
             probes[cost_key(r)] = r
     cost = read_json(work / "cost.json") or {}
     if not a.no_runs:
@@ -452,8 +454,8 @@ def write_doc(a, runs, bim_runs, work, bim_work, cost, projected, totals):
                     f"projected {sec / 3600:.2f} h wall ({how})" if sec else "not projected")
         L.append(f"| {r.label()} ({r.triangles} triangles) | {r.steps()} | {status} | {wall} |")
     L += ["", f"Projected time of the unfinished LBM runs, one after another: **{total / 3600:.1f} h** of wall time "
-              f"at the measured load, **{total_cpu / 3600:.1f} h** of CPU time. Larger lattices are scaled from the",
-          "largest measured one by node count.", ""]
+              f"at the measured load, **{total_cpu / 3600:.1f} h** of CPU time. Lattices not measured are scaled by",
+          "node count from the largest measured one with as many triangles.", ""]
     # Results (the inertia check has a table of its own below)
     main_runs = [r for r in runs if r.reynolds == REYNOLDS]
     radii_all = sorted({r.radius for r in main_runs})
