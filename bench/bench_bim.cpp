@@ -17,6 +17,10 @@
 //                         and rel_diff = max_i |u(x_i) - u_all7(x_i)| / max_i |u_all7(x_i)|. Shapes: the
 //                         red blood cell of eq. (15) (R = 1) and the ellipsoid of half axes
 //                         2, 1, 0.5, both mapped from the MT1 sphere.
+//   BM_TreeParameters/<shape>/leaf:L/degree:Q/tolerance_1e-7:T
+//                         as BM_QuadratureRatio at 5120 triangles on one thread, the tree with
+//                         leaves of at most L triangles, degree Q and tolerance T x 1e-7 (a scan
+//                         around the defaults 32, 7, 2e-6).
 //   BM_StokesletReference/<isa>
 //                         the regular part alone, on contiguous arrays: for every node, the
 //                         Stokeslet sum over the 7 N_T quadrature points of the same mesh, with the
@@ -113,9 +117,10 @@ BENDLAB_SINGLE_LAYER(tree, SingleLayerQuadrature::tree);
 
 enum Shape { kRbc, kEllipsoid };
 
-void BM_QuadratureRatio(benchmark::State& state, Shape shape, SingleLayerQuadrature quadrature) {
-  const TriMesh& sphere = unit_sphere(static_cast<int>(state.range(0)));
-  const int threads = static_cast<int>(state.range(1));
+// all7 (the reference) and `options` on one shape in every iteration; the counters of
+// BM_QuadratureRatio.
+void quadrature_ratio(benchmark::State& state, Shape shape, int triangles, int threads, const SingleLayerOptions& other_options) {
+  const TriMesh& sphere = unit_sphere(triangles);
   omp_set_num_threads(threads);
   Points x = sphere.positions();
   if (shape == kRbc) {
@@ -126,9 +131,8 @@ void BM_QuadratureRatio(benchmark::State& state, Shape shape, SingleLayerQuadrat
   }
   const BendingResult bending = make_bending_method("C")->compute(sphere.topology(), x, 1.0);
   const Points& f = bending.force_density;
-  SingleLayerOptions reference_options, other_options;
+  SingleLayerOptions reference_options;
   reference_options.quadrature = SingleLayerQuadrature::all7;
-  other_options.quadrature = quadrature;
   const StokesSingleLayer reference(sphere.topology_ptr(), reference_options);
   const StokesSingleLayer other(sphere.topology_ptr(), other_options);
   Points u_ref(x.rows(), 3), u(x.rows(), 3);
@@ -148,9 +152,26 @@ void BM_QuadratureRatio(benchmark::State& state, Shape shape, SingleLayerQuadrat
   state.counters["triangles"] = sphere.num_faces();
   state.counters["threads"] = threads;
   state.counters["s_all7"] = t_ref / static_cast<double>(state.iterations());
-  state.counters["s_" + to_string(quadrature)] = t_other / static_cast<double>(state.iterations());
+  state.counters["s_" + to_string(other_options.quadrature)] = t_other / static_cast<double>(state.iterations());
   state.counters["speedup"] = t_ref / t_other;
   state.counters["rel_diff"] = (u - u_ref).rowwise().norm().maxCoeff() / u_ref.rowwise().norm().maxCoeff();
+}
+
+void BM_QuadratureRatio(benchmark::State& state, Shape shape, SingleLayerQuadrature quadrature) {
+  SingleLayerOptions options;
+  options.quadrature = quadrature;
+  quadrature_ratio(state, shape, static_cast<int>(state.range(0)), static_cast<int>(state.range(1)), options);
+}
+
+// The tree around its defaults at 5120 triangles, one thread: arguments leaf size, degree and
+// tolerance in units of 1e-7 (the scan behind the parameters in stokes_single_layer.hpp).
+void BM_TreeParameters(benchmark::State& state, Shape shape) {
+  SingleLayerOptions options;
+  options.quadrature = SingleLayerQuadrature::tree;
+  options.tree_leaf_size = static_cast<int>(state.range(0));
+  options.tree_order = static_cast<int>(state.range(1));
+  options.tree_tolerance = 1e-7 * static_cast<double>(state.range(2));
+  quadrature_ratio(state, shape, 5120, 1, options);
 }
 #define BENDLAB_RATIO(name, shape, q)                    \
   BENCHMARK_CAPTURE(BM_QuadratureRatio, name, shape, q)  \
@@ -162,6 +183,16 @@ BENDLAB_RATIO(rbc, kRbc, SingleLayerQuadrature::adaptive);
 BENDLAB_RATIO(ellipsoid, kEllipsoid, SingleLayerQuadrature::adaptive);
 BENDLAB_RATIO(rbc_tree, kRbc, SingleLayerQuadrature::tree);
 BENDLAB_RATIO(ellipsoid_tree, kEllipsoid, SingleLayerQuadrature::tree);
+
+#define BENDLAB_TREE_SCAN(name, shape)                                                  \
+  BENCHMARK_CAPTURE(BM_TreeParameters, name, shape)                                      \
+      ->Args({32, 7, 20})->Args({16, 7, 20})->Args({48, 7, 20})->Args({64, 7, 20})        \
+      ->Args({32, 6, 20})->Args({32, 8, 20})->Args({32, 7, 40})                            \
+      ->ArgNames({"leaf", "degree", "tolerance_1e-7"})                                     \
+      ->UseRealTime()                                                                      \
+      ->Unit(benchmark::kMillisecond)
+BENDLAB_TREE_SCAN(rbc, kRbc);
+BENDLAB_TREE_SCAN(ellipsoid, kEllipsoid);
 
 // Quadrature points and weighted densities of the 7-point rule on every triangle, structure of
 // arrays, as the solver lays them out.

@@ -320,7 +320,7 @@ def main():
 
         skipped = set()
         for r in bim["rows"]:
-            if r["family"] in ("BM_MultiplyAddPeak", "BM_QuadratureRatio"):
+            if r["family"] in ("BM_MultiplyAddPeak", "BM_QuadratureRatio", "BM_TreeParameters"):
                 continue
             b, a_ = r["b"], r["args"]
             label = r["family"] + (f" ({r['variant']})" if r["variant"] else "")
@@ -354,6 +354,19 @@ def main():
                 other = "tree" if "s_tree" in b else "adaptive"
                 w(f"| {r['variant']} | {a_.get('triangles')} | {a_.get('threads')} | {b.get('s_all7', 0):.4g} | "
                   f"{other} | {b.get('s_' + other, float('nan')):.4g} | {b.get('speedup', 0):.2f} | "
+                  f"{b.get('rel_diff', 0):.2e} |")
+            w("")
+        scan = [r for r in bim["rows"] if r["family"] == "BM_TreeParameters" and not r["error"]]
+        if scan:
+            w("`BM_TreeParameters`: the tree against all7 as above at 5120 triangles on one thread, around its")
+            w("defaults (leaves of at most 32 triangles, degree 7, tolerance 2e-6):")
+            w("")
+            w("| shape | leaf | degree | tolerance | s all7 | s tree | speedup | difference |")
+            w("| --- | --- | --- | --- | --- | --- | --- | --- |")
+            for r in scan:
+                b, a_ = r["b"], r["args"]
+                w(f"| {r['variant']} | {a_.get('leaf')} | {a_.get('degree')} | {1e-7 * float(a_.get('tolerance_1e-7', 0)):.0e} | "
+                  f"{b.get('s_all7', 0):.4g} | {b.get('s_tree', float('nan')):.4g} | {b.get('speedup', 0):.2f} | "
                   f"{b.get('rel_diff', 0):.2e} |")
             w("")
         peaks = [r for r in bim["rows"] if r["family"] == "BM_MultiplyAddPeak"]

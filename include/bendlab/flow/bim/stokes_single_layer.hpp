@@ -68,6 +68,16 @@
 //   sums alone would be about 2.4 times faster; the rest is
 //   the set-up (moments about 12 %, boxes 5 %), the traversal and the polar integrals (together
 //   about 20 %). The 3x target at 1e-5 is not reached at 5120 triangles; the rule is not the default.
+//   Tried on an AMD EPYC with AVX2 (5120 triangles, Method C's density, one thread, processor
+//   time, best of three; bench_bim --benchmark_filter=BM_TreeParameters repeats the scan in wall
+//   time): the parameters around the defaults are a flat optimum, speed-up over
+//   all7 (red blood cell / ellipsoid) 1.50 / 1.71 at the defaults, 1.39-1.53 / 1.57-1.79 with
+//   leaves of 16 to 64 or degree 6 or 8, 1.61 / 1.82 with tolerance 4e-6 (difference 4.2e-6).
+//   The regular sums are 64 % of the time (perf), the moments 12 %. 1/r from the single-precision
+//   reciprocal square root and two Newton steps in double (AVX2 intrinsics, relative error about
+//   1e-13) instead of the square root and division was slower there (an experiment, not kept),
+//   all7 164 ms against 142 ms:
+//   the kernel trades the divider's throughput for the multiply-add ports, which are then full.
 //   Not tried: single-precision proxy sums, target clusters sharing one traversal, a cheaper rule
 //   for near triangles a few edge lengths away (the 7-point sums are now over half the work).
 // - Triangles that contain x_i: polar coordinates (rho, phi) centred on x_i [118]. There
