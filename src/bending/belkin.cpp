@@ -17,6 +17,7 @@
 namespace bendlab {
 
 namespace {
+constexpr double kLog2e = 1.4426950408889634074;
 // Terms with |p - x_i|^2 / (4 a_i) above this are skipped; see the bound in belkin.hpp.
 constexpr double kMaxExponent = 80.0;
 // A point p counts as above the plane of x_i when (p - c).(x_i - c) > kPlaneTolerance |p - c| |x_i - c|.
@@ -143,6 +144,22 @@ struct GridInput {
 };
 enum class Field { scalar, positions };
 
+// The kernels' input: the point arrays and a field in scan order (w, or null), ...
+GridInput grid_input(const double* sx, const double* sy, const double* sz, const double* sn, const double* sl,
+                     const double* w, double max_exponent) {
+  GridInput in{};
+  in.sx = sx, in.sy = sy, in.sz = sz, in.sn = sn, in.sl = sl, in.w = w;
+  in.ymax = max_exponent * kLog2e;
+  return in;
+}
+// ... and vertex i's part: its centred position, |x_i - c|, a_i and the field there.
+void set_vertex(GridInput& in, double x, double y, double z, double norm, double a, double wi) {
+  in.xi = x, in.yi = y, in.zi = z;
+  in.margin = kPlaneTolerance * norm;
+  in.scale = kLog2e / (4.0 * a);
+  in.wi = wi;
+}
+
 // The grid form's kernel: the sum of eq. (13) for one vertex over its runs, as run_sum_body but
 // in blocks of Lanes (one vector register: 8 with AVX-512, 4 with AVX2; the runs are short, about
 // 35 points, so wider blocks waste lanes at the run ends: measured 7 % slower with 8 on AVX2), with the
@@ -188,6 +205,74 @@ __attribute__((always_inline)) inline void grid_sum_body(const GridInput& in, co
   }
 }
 
+// grid_sum_body for Lap x (Field::positions) that also writes its `weight` of every lane of every
+// block of vertex i's runs, in scan order, into out (zero for the lanes it drops), so that the
+// applies of one shape compute each exponential once (BelkinLaplacian::weights_).
+template <bool Plane, int kGridLanes>
+__attribute__((always_inline)) inline void grid_weights_body(const GridInput& in, const int* runs, int nruns,
+                                                             double* __restrict out, double* acc) {
+  const double *sx = in.sx, *sy = in.sy, *sz = in.sz, *sn = in.sn, *sl = in.sl;
+  const double xi = in.xi, yi = in.yi, zi = in.zi, margin = in.margin, scale = in.scale, ymax = in.ymax;
+  double a0[kGridLanes] = {}, a1[kGridLanes] = {}, a2[kGridLanes] = {};
+  for (int r = 0; r < nruns; ++r) {
+    const std::int64_t k1 = runs[2 * r + 1];
+    for (std::int64_t k0 = runs[2 * r]; k0 < k1; k0 += kGridLanes, out += kGridLanes) {
+#pragma omp simd
+      for (std::int64_t l = 0; l < kGridLanes; ++l) {
+        const std::int64_t k = k0 + l;
+        const double dx = sx[k] - xi, dy = sy[k] - yi, dz = sz[k] - zi;
+        const double y = (dx * dx + dy * dy + dz * dz) * scale;
+        bool keep = (y <= ymax) & (k < k1);
+        if constexpr (Plane) keep = keep & (sx[k] * xi + sy[k] * yi + sz[k] * zi > margin * sn[k]);
+        const double weight = (keep ? sl[k] : 0.0) * exp2_neg(std::min(y, ymax));
+        out[l] = weight;
+        a0[l] += weight * dx;
+        a1[l] += weight * dy;
+        a2[l] += weight * dz;
+      }
+    }
+  }
+  for (int l = 0; l < kGridLanes; ++l) {
+    acc[0] += a0[l];
+    acc[1] += a1[l];
+    acc[2] += a2[l];
+  }
+}
+
+// grid_sum_body with the weights read from grid_weights_body's output: the same terms, summed in
+// the same order.
+template <Field Kind, int kGridLanes>
+__attribute__((always_inline)) inline void grid_cached_body(const GridInput& in, const int* runs, int nruns,
+                                                            const double* __restrict wt, double* acc) {
+  const double *sx = in.sx, *sy = in.sy, *sz = in.sz, *w = in.w;
+  const double xi = in.xi, yi = in.yi, zi = in.zi, wi = in.wi;
+  double a0[kGridLanes] = {}, a1[kGridLanes] = {}, a2[kGridLanes] = {};
+  for (int r = 0; r < nruns; ++r) {
+    const std::int64_t k1 = runs[2 * r + 1];
+    for (std::int64_t k0 = runs[2 * r]; k0 < k1; k0 += kGridLanes, wt += kGridLanes) {
+#pragma omp simd
+      for (std::int64_t l = 0; l < kGridLanes; ++l) {
+        const std::int64_t k = k0 + l;
+        const double weight = wt[l];
+        if constexpr (Kind == Field::scalar) {
+          a0[l] += weight * (w[k] - wi);
+        } else {
+          a0[l] += weight * (sx[k] - xi);
+          a1[l] += weight * (sy[k] - yi);
+          a2[l] += weight * (sz[k] - zi);
+        }
+      }
+    }
+  }
+  for (int l = 0; l < kGridLanes; ++l) {
+    acc[0] += a0[l];
+    if constexpr (Kind == Field::positions) {
+      acc[1] += a1[l];
+      acc[2] += a2[l];
+    }
+  }
+}
+
 // Compiled for AVX-512, AVX2+FMA and baseline x86-64 and picked at run time (as the boundary
 // integral's kernel, stokes_single_layer.cpp).
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
@@ -217,9 +302,33 @@ BENDLAB_GRID_KERNEL(grid_sum_scalar_plane4, Field::scalar, true, 4)
 BENDLAB_GRID_KERNEL(grid_sum_positions4, Field::positions, false, 4)
 BENDLAB_GRID_KERNEL(grid_sum_positions_plane4, Field::positions, true, 4)
 #undef BENDLAB_GRID_KERNEL
-// [field][plane]: field 0 scalar, 1 positions; the block width of the processor's widest vectors.
+using WeightKernel = void (*)(const GridInput&, const int*, int, double*, double*);
+using CachedKernel = void (*)(const GridInput&, const int*, int, const double*, double*);
+#define BENDLAB_WEIGHT_KERNEL(name, plane, lanes)                                                              \
+  BENDLAB_KERNEL_CLONES void name(const GridInput& in, const int* runs, int nruns, double* out, double* acc) { \
+    grid_weights_body<plane, lanes>(in, runs, nruns, out, acc);                                                \
+  }
+#define BENDLAB_CACHED_KERNEL(name, kind, lanes)                                                                   \
+  BENDLAB_KERNEL_CLONES void name(const GridInput& in, const int* runs, int nruns, const double* wt, double* acc) { \
+    grid_cached_body<kind, lanes>(in, runs, nruns, wt, acc);                                                       \
+  }
+BENDLAB_WEIGHT_KERNEL(grid_weights8, false, 8)
+BENDLAB_WEIGHT_KERNEL(grid_weights_plane8, true, 8)
+BENDLAB_WEIGHT_KERNEL(grid_weights4, false, 4)
+BENDLAB_WEIGHT_KERNEL(grid_weights_plane4, true, 4)
+BENDLAB_CACHED_KERNEL(grid_cached_scalar8, Field::scalar, 8)
+BENDLAB_CACHED_KERNEL(grid_cached_positions8, Field::positions, 8)
+BENDLAB_CACHED_KERNEL(grid_cached_scalar4, Field::scalar, 4)
+BENDLAB_CACHED_KERNEL(grid_cached_positions4, Field::positions, 4)
+#undef BENDLAB_WEIGHT_KERNEL
+#undef BENDLAB_CACHED_KERNEL
+// k[field][plane]: field 0 scalar, 1 positions; weights[plane]; cached[field]; the block width
+// (lanes) of the processor's widest vectors.
 struct GridKernels {
   GridKernel k[2][2];
+  WeightKernel weights[2];
+  CachedKernel cached[2];
+  int lanes;
 };
 const GridKernels& grid_kernels() {
   static const GridKernels kernels = [] {
@@ -228,8 +337,14 @@ const GridKernels& grid_kernels() {
 #else
     const bool wide = true;
 #endif
-    return wide ? GridKernels{{{grid_sum_scalar8, grid_sum_scalar_plane8}, {grid_sum_positions8, grid_sum_positions_plane8}}}
-                : GridKernels{{{grid_sum_scalar4, grid_sum_scalar_plane4}, {grid_sum_positions4, grid_sum_positions_plane4}}};
+    return wide ? GridKernels{{{grid_sum_scalar8, grid_sum_scalar_plane8}, {grid_sum_positions8, grid_sum_positions_plane8}},
+                              {grid_weights8, grid_weights_plane8},
+                              {grid_cached_scalar8, grid_cached_positions8},
+                              8}
+                : GridKernels{{{grid_sum_scalar4, grid_sum_scalar_plane4}, {grid_sum_positions4, grid_sum_positions_plane4}},
+                              {grid_weights4, grid_weights_plane4},
+                              {grid_cached_scalar4, grid_cached_positions4},
+                              4};
   }();
   return kernels;
 }
@@ -288,6 +403,36 @@ BelkinLaplacian::BelkinLaplacian(const Topology& topology, const Points& x, cons
     arrays[2 * stride_ + k] = qz_[p];
     arrays[3 * stride_ + k] = qnorm_[p];
     arrays[4 * stride_ + k] = lumped_area_[p];
+  }
+  if (!run_shared_) cache_weights();
+}
+
+void BelkinLaplacian::cache_weights() {
+  const GridKernels& kernels = grid_kernels();
+  const int lanes = kernels.lanes;
+  std::vector<std::size_t> start(static_cast<std::size_t>(n_) + 1, 0);
+  for (int i = 0; i < n_; ++i) {
+    std::size_t count = 0;
+    for (int r = run_start_[i]; r < run_start_[i + 1]; r += 2)
+      count += static_cast<std::size_t>((runs_[r + 1] - runs_[r] + lanes - 1) / lanes * lanes);
+    start[i + 1] = start[i] + count;
+  }
+  if (start[n_] > options_.weight_cache_bytes / sizeof(double)) return;
+  weight_start_ = std::move(start);
+  // Not zeroed: every entry is written below, each vertex's range by the thread that reads it later.
+  weights_.reset(new double[std::max<std::size_t>(weight_start_[n_], 1)]);
+  GridInput in = grid_input(point_array(0), point_array(1), point_array(2), point_array(3), point_array(4), nullptr,
+                            max_exponent_);
+  lap_positions_.resize(n_, 3);
+#pragma omp parallel for schedule(dynamic, 64) firstprivate(in)
+  for (int i = 0; i < n_; ++i) {
+    set_vertex(in, qx_[i], qy_[i], qz_[i], qnorm_[i], kernel_area_[i], 0.0);
+    double acc[3] = {0, 0, 0};
+    kernels.weights[plane_test_[i] ? 1 : 0](in, runs_.data() + run_start_[i], (run_start_[i + 1] - run_start_[i]) / 2,
+                                            weights_.get() + weight_start_[i], acc);
+    const double a = kernel_area_[i];
+    const double scale = 1.0 / (4.0 * M_PI * a * a);  // eq. (13) prefactor
+    for (int col = 0; col < 3; ++col) lap_positions_(i, col) = scale * acc[col];
   }
 }
 
@@ -451,23 +596,21 @@ void BelkinLaplacian::apply_grid(const double* w, double* const* out) const {
   std::vector<double> buffer(w ? n_ + kLanes + 8 : 0, 0.0);
   double* ws = w ? aligned64(buffer.data()) : nullptr;
   for (int k = 0; w && k < n_; ++k) ws[k] = w[order_[k]];
-  GridInput in{};
-  in.sx = point_array(0), in.sy = point_array(1), in.sz = point_array(2), in.sn = point_array(3);
-  in.sl = point_array(4), in.w = ws;
-  constexpr double log2e = 1.4426950408889634074;
-  in.ymax = max_exponent_ * log2e;
+  GridInput in = grid_input(point_array(0), point_array(1), point_array(2), point_array(3), point_array(4), ws,
+                            max_exponent_);
   const GridKernels& kernels = grid_kernels();
+  const double* weights = weights_.get();
 #pragma omp parallel for schedule(dynamic, 64) firstprivate(in)
   for (int i = 0; i < n_; ++i) {
-    in.xi = qx_[i], in.yi = qy_[i], in.zi = qz_[i];
-    in.margin = kPlaneTolerance * qnorm_[i];
-    const double a = kernel_area_[i];
-    in.scale = log2e / (4.0 * a);
-    in.wi = w ? w[i] : 0.0;
+    set_vertex(in, qx_[i], qy_[i], qz_[i], qnorm_[i], kernel_area_[i], w ? w[i] : 0.0);
     double acc[3] = {0, 0, 0};
     const int* runs = runs_.data() + run_start_[i];
     const int nruns = (run_start_[i + 1] - run_start_[i]) / 2;
-    kernels.k[w ? 0 : 1][plane_test_[i] ? 1 : 0](in, runs, nruns, acc);
+    if (weights)
+      kernels.cached[w ? 0 : 1](in, runs, nruns, weights + weight_start_[i], acc);
+    else
+      kernels.k[w ? 0 : 1][plane_test_[i] ? 1 : 0](in, runs, nruns, acc);
+    const double a = kernel_area_[i];
     const double scale = 1.0 / (4.0 * M_PI * a * a);  // eq. (13) prefactor
     for (int col = 0; col < (w ? 1 : 3); ++col) out[col][i] = scale * acc[col];
   }
@@ -508,6 +651,7 @@ Points BelkinLaplacian::apply_to_positions() const {
     for (int p = 0; p < n_; ++p) q.row(p) = Eigen::RowVector3d(qx_[p], qy_[p], qz_[p]);
     return apply(q);
   }
+  if (weights_) return lap_positions_;  // computed with the weights
   Eigen::MatrixXd oc(n_, 3);
   double* res[3] = {oc.col(0).data(), oc.col(1).data(), oc.col(2).data()};
   apply_grid(nullptr, res);

@@ -308,6 +308,25 @@ TEST(BelkinLaplacian, GridFormEqualsAllPairsForm) {
   }
 }
 
+TEST(BelkinLaplacian, KeptWeightsGiveTheSameSums) {
+  // The grid form keeps its kernel weights for every apply when they fit weight_cache_bytes, else
+  // computes them in each: the same terms summed in the same order, so the same numbers.
+  BelkinOptions kept, recomputed;
+  recomputed.weight_cache_bytes = 0;
+  const TriMesh m = sphere_mesh(MeshFamily::MT1, 3);
+  const Points x = deformed(rbc_points(m));
+  const MeshGeometry g = MeshGeometry::compute(m.topology(), x);
+  Scalars w(m.num_vertices());
+  for (int i = 0; i < w.size(); ++i) w[i] = std::cos(2 * x(i, 2)) - x(i, 0);
+  const BelkinLaplacian lk(m.topology(), x, g, kept), lr(m.topology(), x, g, recomputed);
+  EXPECT_LE(rel_max_diff(lk.apply(w), lr.apply(w)), 1e-15);
+  EXPECT_LE(rel_max_diff(lk.apply_to_positions(), lr.apply_to_positions()), 1e-15);
+  EXPECT_LE(rel_max_diff(lk.apply(x), lr.apply(x)), 1e-15);
+  const BendingResult rk = BelkinMethod(kept).compute(m.topology(), x, 1.0);
+  const BendingResult rr = BelkinMethod(recomputed).compute(m.topology(), x, 1.0);
+  EXPECT_LE(rel_max_diff(rk.force_density, rr.force_density), 1e-15);
+}
+
 TEST(BelkinMethod, NeighbourOptions) {
   EXPECT_EQ(static_cast<const BelkinMethod&>(*BelkinMethod::create({})).options().neighbours,
             BelkinOptions::Neighbours::grid);

@@ -67,6 +67,12 @@
 // (3.3-3.8 us per vertex), C 0.0005 / 0.0026 / 0.0106 s, D / C 18 / 13 / 12.7; stages at 81920:
 // geometry 0.009 s, set-up 0.016 s, Lap x 0.058 s, Lap H 0.055 s (the kernel there costs 2.6 times
 // the AVX-512 machine's; before Estrin's scheme, 4 lanes and FMA: Lap x 0.084 s, Lap H 0.078 s).
+// Kept weights (BelkinOptions::weight_cache_bytes; the construction sums Lap x while it writes the
+// weights, Lap H reads them), same machine and command, old and new binary in turn: D 0.0067 /
+// 0.026-0.027 / 0.104-0.106 s (2.5-2.6 us per vertex) against 0.0096 / 0.034 / 0.135 s before,
+// D / C 11.7-12.2 / 11.7-12.2 / 10.3-10.9; stages at 81920: set-up with the weights and Lap x
+// 0.079 s, Lap H 0.016 s (a read of the 160 MB of weights). The 5x of Method C is not reached:
+// the exponentials alone (the weights pass) cost 6 times C there.
 // Without the two variables the same run is not a measure of D: first touch of fresh memory costs
 // 17 us per 4 KiB page on that virtual machine, and what glibc hands back between evaluations
 // depends on what the other method freed. Measured there: with this code C 0.041-0.060 s after D
@@ -92,6 +98,11 @@ struct BelkinOptions {
   Neighbours neighbours = Neighbours::grid;
   /// grid only: kernel weights exp(-|p - x_i|^2 / (4 a_i)) below this are dropped (header comment).
   double kernel_cutoff = 1e-15;
+  /// grid only: the kernel weights of the shape (one per point a vertex scans, 8 bytes each) are
+  /// computed once, when the operator is constructed, and kept for every apply() when they take at
+  /// most this many bytes (about 4 kB a vertex at the default cut-off); above it (or 0) every
+  /// apply() computes them again. Either way the same terms in the same order.
+  std::size_t weight_cache_bytes = std::size_t{1} << 30;
 };
 
 /// Belkin's heat-kernel Laplace-Beltrami, eq. (13), div-grad sign, with a_i = mixed area and the
@@ -125,6 +136,7 @@ class BelkinLaplacian {
   void apply_columns(const double* const* w, double* const* out) const;
   void apply_grid(const double* w, double* const* out) const;
   void build_grid();
+  void cache_weights();
   /// Array j of the points in scan order (0, 1, 2: centred position; 3: |x_p - c|; 4: lumped
   /// area), 64-byte aligned, padded by zeros.
   const double* point_array(int j) const;
@@ -151,6 +163,13 @@ class BelkinLaplacian {
   /// Grid form: 1 where vertex i's ball crosses the half-space plane (the kernel tests each
   /// point), 0 where every point within its cut-off radius lies above it.
   std::vector<unsigned char> plane_test_;
+  /// Grid form, when they fit options.weight_cache_bytes (else null): the kernel weights
+  /// A_p exp(-|p - x_i|^2 / (4 a_i)) of every lane of every block vertex i scans (zero where a
+  /// term is dropped), from weight_start_[i], so that Lap x and Lap H evaluate each exponential once.
+  std::unique_ptr<double[]> weights_;
+  std::vector<std::size_t> weight_start_;
+  /// Lap x, summed in the same pass as the weights (apply_to_positions() returns it then).
+  Points lap_positions_;
 };
 
 /// Method D: normal = MWA; H by eq. (2) with eq. (13) (H = -1/2 (Lap x) . n); lapH by eq. (13)
