@@ -8,6 +8,7 @@
 #include <limits>
 #include <numeric>
 #include <string>
+#include <utility>
 
 #include <omp.h>
 
@@ -166,9 +167,12 @@ void set_vertex(GridInput& in, double x, double y, double z, double norm, double
 // exponent in base 2 (y = |p - x_i|^2 log2(e) / (4 a_i), kept where y <= ymax, exp2_neg), the
 // half-space test only where the vertex's ball crosses the plane (Plane), and for
 // Field::positions w(p) - w(x_i) = p - x_i, the differences the distance is made of (Lap x).
-template <Field Kind, bool Plane, int kGridLanes>
+// Store: also write the weight of every lane of every block, in scan order, to out (zero for the
+// lanes it drops), so that later applies to the same shape need no exponential
+// (BelkinLaplacian::weights_, grid_cached_body).
+template <Field Kind, bool Plane, int kGridLanes, bool Store = false>
 __attribute__((always_inline)) inline void grid_sum_body(const GridInput& in, const int* runs, int nruns,
-                                                         double* acc) {
+                                                         double* acc, double* __restrict out = nullptr) {
   const double *sx = in.sx, *sy = in.sy, *sz = in.sz, *sn = in.sn, *sl = in.sl, *w = in.w;
   const double xi = in.xi, yi = in.yi, zi = in.zi, margin = in.margin, scale = in.scale, ymax = in.ymax;
   const double wi = in.wi;
@@ -186,6 +190,7 @@ __attribute__((always_inline)) inline void grid_sum_body(const GridInput& in, co
         if constexpr (Plane) keep = keep & (sx[k] * xi + sy[k] * yi + sz[k] * zi > margin * sn[k]);
         const double lump = sl[k], kernel = exp2_neg(std::min(y, ymax));
         const double weight = (keep ? lump : 0.0) * kernel;
+        if constexpr (Store) out[l] = weight;
         if constexpr (Kind == Field::scalar) {
           a0[l] += weight * (w[k] - wi);
         } else {
@@ -194,6 +199,7 @@ __attribute__((always_inline)) inline void grid_sum_body(const GridInput& in, co
           a2[l] += weight * dz;
         }
       }
+      if constexpr (Store) out += kGridLanes;
     }
   }
   for (int l = 0; l < kGridLanes; ++l) {
@@ -205,42 +211,8 @@ __attribute__((always_inline)) inline void grid_sum_body(const GridInput& in, co
   }
 }
 
-// grid_sum_body for Lap x (Field::positions) that also writes its `weight` of every lane of every
-// block of vertex i's runs, in scan order, into out (zero for the lanes it drops), so that the
-// applies of one shape compute each exponential once (BelkinLaplacian::weights_).
-template <bool Plane, int kGridLanes>
-__attribute__((always_inline)) inline void grid_weights_body(const GridInput& in, const int* runs, int nruns,
-                                                             double* __restrict out, double* acc) {
-  const double *sx = in.sx, *sy = in.sy, *sz = in.sz, *sn = in.sn, *sl = in.sl;
-  const double xi = in.xi, yi = in.yi, zi = in.zi, margin = in.margin, scale = in.scale, ymax = in.ymax;
-  double a0[kGridLanes] = {}, a1[kGridLanes] = {}, a2[kGridLanes] = {};
-  for (int r = 0; r < nruns; ++r) {
-    const std::int64_t k1 = runs[2 * r + 1];
-    for (std::int64_t k0 = runs[2 * r]; k0 < k1; k0 += kGridLanes, out += kGridLanes) {
-#pragma omp simd
-      for (std::int64_t l = 0; l < kGridLanes; ++l) {
-        const std::int64_t k = k0 + l;
-        const double dx = sx[k] - xi, dy = sy[k] - yi, dz = sz[k] - zi;
-        const double y = (dx * dx + dy * dy + dz * dz) * scale;
-        bool keep = (y <= ymax) & (k < k1);
-        if constexpr (Plane) keep = keep & (sx[k] * xi + sy[k] * yi + sz[k] * zi > margin * sn[k]);
-        const double weight = (keep ? sl[k] : 0.0) * exp2_neg(std::min(y, ymax));
-        out[l] = weight;
-        a0[l] += weight * dx;
-        a1[l] += weight * dy;
-        a2[l] += weight * dz;
-      }
-    }
-  }
-  for (int l = 0; l < kGridLanes; ++l) {
-    acc[0] += a0[l];
-    acc[1] += a1[l];
-    acc[2] += a2[l];
-  }
-}
-
-// grid_sum_body with the weights read from grid_weights_body's output: the same terms, summed in
-// the same order.
+// grid_sum_body with the weights it stored (Store) read back: the same terms, summed in the same
+// order.
 template <Field Kind, int kGridLanes>
 __attribute__((always_inline)) inline void grid_cached_body(const GridInput& in, const int* runs, int nruns,
                                                             const double* __restrict wt, double* acc) {
@@ -306,7 +278,7 @@ using WeightKernel = void (*)(const GridInput&, const int*, int, double*, double
 using CachedKernel = void (*)(const GridInput&, const int*, int, const double*, double*);
 #define BENDLAB_WEIGHT_KERNEL(name, plane, lanes)                                                              \
   BENDLAB_KERNEL_CLONES void name(const GridInput& in, const int* runs, int nruns, double* out, double* acc) { \
-    grid_weights_body<plane, lanes>(in, runs, nruns, out, acc);                                                \
+    grid_sum_body<Field::positions, plane, lanes, true>(in, runs, nruns, acc, out);                            \
   }
 #define BENDLAB_CACHED_KERNEL(name, kind, lanes)                                                                   \
   BENDLAB_KERNEL_CLONES void name(const GridInput& in, const int* runs, int nruns, const double* wt, double* acc) { \
@@ -348,6 +320,15 @@ const GridKernels& grid_kernels() {
   }();
   return kernels;
 }
+
+// The largest weight buffer a BelkinLaplacian of this thread released (~BelkinLaplacian): a
+// shape's weights reuse its pages, which on some virtual machines cost more to touch afresh
+// (tens of microseconds per 4 KiB page) than the sums that fill them.
+struct SpareWeights {
+  std::unique_ptr<double[]> data;
+  std::size_t capacity = 0;
+};
+thread_local SpareWeights spare_weights;
 
 // A 64-byte aligned position in a buffer of doubles with 8 spare entries at its start.
 inline double* aligned64(double* p) {
@@ -407,6 +388,13 @@ BelkinLaplacian::BelkinLaplacian(const Topology& topology, const Points& x, cons
   if (!run_shared_) cache_weights();
 }
 
+BelkinLaplacian::~BelkinLaplacian() {
+  if (weights_.data && weights_.capacity >= spare_weights.capacity) {
+    spare_weights.data = std::move(weights_.data);
+    spare_weights.capacity = weights_.capacity;
+  }
+}
+
 void BelkinLaplacian::cache_weights() {
   const GridKernels& kernels = grid_kernels();
   const int lanes = kernels.lanes;
@@ -420,7 +408,14 @@ void BelkinLaplacian::cache_weights() {
   if (start[n_] > options_.weight_cache_bytes / sizeof(double)) return;
   weight_start_ = std::move(start);
   // Not zeroed: every entry is written below, each vertex's range by the thread that reads it later.
-  weights_.reset(new double[std::max<std::size_t>(weight_start_[n_], 1)]);
+  const std::size_t need = std::max<std::size_t>(weight_start_[n_], 1);
+  if (spare_weights.capacity >= need) {
+    weights_.data = std::move(spare_weights.data);
+    weights_.capacity = std::exchange(spare_weights.capacity, 0);
+  } else {
+    weights_.data.reset(new double[need]);
+    weights_.capacity = need;
+  }
   GridInput in = grid_input(point_array(0), point_array(1), point_array(2), point_array(3), point_array(4), nullptr,
                             max_exponent_);
   lap_positions_.resize(n_, 3);
@@ -429,7 +424,7 @@ void BelkinLaplacian::cache_weights() {
     set_vertex(in, qx_[i], qy_[i], qz_[i], qnorm_[i], kernel_area_[i], 0.0);
     double acc[3] = {0, 0, 0};
     kernels.weights[plane_test_[i] ? 1 : 0](in, runs_.data() + run_start_[i], (run_start_[i + 1] - run_start_[i]) / 2,
-                                            weights_.get() + weight_start_[i], acc);
+                                            weights_.data.get() + weight_start_[i], acc);
     const double a = kernel_area_[i];
     const double scale = 1.0 / (4.0 * M_PI * a * a);  // eq. (13) prefactor
     for (int col = 0; col < 3; ++col) lap_positions_(i, col) = scale * acc[col];
@@ -599,7 +594,7 @@ void BelkinLaplacian::apply_grid(const double* w, double* const* out) const {
   GridInput in = grid_input(point_array(0), point_array(1), point_array(2), point_array(3), point_array(4), ws,
                             max_exponent_);
   const GridKernels& kernels = grid_kernels();
-  const double* weights = weights_.get();
+  const double* weights = weights_.data.get();
 #pragma omp parallel for schedule(dynamic, 64) firstprivate(in)
   for (int i = 0; i < n_; ++i) {
     set_vertex(in, qx_[i], qy_[i], qz_[i], qnorm_[i], kernel_area_[i], w ? w[i] : 0.0);
@@ -651,7 +646,7 @@ Points BelkinLaplacian::apply_to_positions() const {
     for (int p = 0; p < n_; ++p) q.row(p) = Eigen::RowVector3d(qx_[p], qy_[p], qz_[p]);
     return apply(q);
   }
-  if (weights_) return lap_positions_;  // computed with the weights
+  if (weights_.data) return lap_positions_;  // computed with the weights
   Eigen::MatrixXd oc(n_, 3);
   double* res[3] = {oc.col(0).data(), oc.col(1).data(), oc.col(2).data()};
   apply_grid(nullptr, res);

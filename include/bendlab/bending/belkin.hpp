@@ -68,11 +68,12 @@
 // geometry 0.009 s, set-up 0.016 s, Lap x 0.058 s, Lap H 0.055 s (the kernel there costs 2.6 times
 // the AVX-512 machine's; before Estrin's scheme, 4 lanes and FMA: Lap x 0.084 s, Lap H 0.078 s).
 // Kept weights (BelkinOptions::weight_cache_bytes; the construction sums Lap x while it writes the
-// weights, Lap H reads them), same machine and command, old and new binary in turn: D 0.0067 /
-// 0.026-0.027 / 0.104-0.106 s (2.5-2.6 us per vertex) against 0.0096 / 0.034 / 0.135 s before,
-// D / C 11.7-12.2 / 11.7-12.2 / 10.3-10.9; stages at 81920: set-up with the weights and Lap x
-// 0.079 s, Lap H 0.016 s (a read of the 160 MB of weights). The 5x of Method C is not reached:
-// the exponentials alone (the weights pass) cost 6 times C there.
+// weights, Lap H reads them; the buffer reused from shape to shape), same machine and command, old
+// and new binary in turn: D 0.0067-0.0081 / 0.026-0.030 / 0.104-0.111 s (2.5-3.2 us per vertex)
+// against 0.0096 / 0.034 / 0.135 s before, D / C 8.9-12.8 at every size; without the two
+// variables D 0.0078 / 0.027 / 0.106-0.112 s against 0.0101 / 0.037 / 0.146 s. Stages at 81920:
+// set-up with the weights and Lap x 0.079 s, Lap H 0.016 s (a read of the 160 MB of weights). The
+// 5x of Method C is not reached: the exponentials alone (the weights pass) cost 6 times C there.
 // Without the two variables the same run is not a measure of D: first touch of fresh memory costs
 // 17 us per 4 KiB page on that virtual machine, and what glibc hands back between evaluations
 // depends on what the other method freed. Measured there: with this code C 0.041-0.060 s after D
@@ -101,7 +102,8 @@ struct BelkinOptions {
   /// grid only: the kernel weights of the shape (one per point a vertex scans, 8 bytes each) are
   /// computed once, when the operator is constructed, and kept for every apply() when they take at
   /// most this many bytes (about 4 kB a vertex at the default cut-off); above it (or 0) every
-  /// apply() computes them again. Either way the same terms in the same order.
+  /// apply() computes them again. Either way the same terms in the same order. Each thread keeps
+  /// the largest weight buffer it has released for the next shape (~BelkinLaplacian).
   std::size_t weight_cache_bytes = std::size_t{1} << 30;
 };
 
@@ -123,6 +125,11 @@ class BelkinLaplacian {
  public:
   BelkinLaplacian(const Topology& topology, const Points& x, const MeshGeometry& geometry,
                   BelkinOptions options = {});
+  /// Hands the weights' memory to a spare kept per thread, which the next operator built on that
+  /// thread reuses when it is large enough (fresh pages cost more to touch than the sums take).
+  ~BelkinLaplacian();
+  BelkinLaplacian(BelkinLaplacian&&) = default;
+  BelkinLaplacian& operator=(BelkinLaplacian&&) = default;
   Scalars apply(const Scalars& w) const;
   Points apply(const Points& w) const;
   /// Lap x: the operator applied to the positions it was built from (equal to apply(x) up to
@@ -166,7 +173,11 @@ class BelkinLaplacian {
   /// Grid form, when they fit options.weight_cache_bytes (else null): the kernel weights
   /// A_p exp(-|p - x_i|^2 / (4 a_i)) of every lane of every block vertex i scans (zero where a
   /// term is dropped), from weight_start_[i], so that Lap x and Lap H evaluate each exponential once.
-  std::unique_ptr<double[]> weights_;
+  struct WeightBuffer {
+    std::unique_ptr<double[]> data;
+    std::size_t capacity = 0;
+  };
+  WeightBuffer weights_;
   std::vector<std::size_t> weight_start_;
   /// Lap x, summed in the same pass as the weights (apply_to_positions() returns it then).
   Points lap_positions_;
