@@ -4,19 +4,21 @@ resolution study of shared/spec/LBM_IBM.md section 5.
 
     /usr/bin/python3 scripts/lbm_study.py [--radii 6,8,10] [--full] [--t-end T]
                                           [--measure-steps N] [--only-measure] [--no-runs] [--no-bim] [--jobs N]
-                                          [--inertia-radius R] [--bim-work DIR] [--work DIR] [--doc FILE] [--bendlab PATH]
+                                          [--check-radius R] [--bim-work DIR] [--work DIR] [--doc FILE] [--bendlab PATH]
 
 Cases: (G, kappa_b_hat) = (0.05, 0.0375) and (0.2, 0.15) with the paper's LBM methods A and B
 (figure 15), and kappa_b_hat = 0 at the same G, each at R = 6, 8, 10 lattice units (--radii), with
 the same box in multiples of R (8 x 8 x 10, walls 10 R apart), tau = 1, Re = R v / nu = 0.2
 (particle Re = gamma R^2 / nu = 0.04) and 1280 triangles. --full adds the paper's own size:
-R = 13.5, 5120 triangles, box 9.5 R x 9.5 R x 19 R (128 x 128 x 256 nodes).
+R = 13.5, 5120 triangles, box 9.5 R x 9.5 R x 19 R (128 x 128 x 257 nodes: 19 x 13.5 rounded up).
 
 For each case the steady D (gamma t in [5, 10]) is fitted as D(R) = D_inf + a / R^p (three radii
 determine D_inf, a and p; with two only p = 1 is assumed), and the smallest R within 2 % of D_inf
-is named (the spec's protocol), and D_inf is checked against the BIM: within 3 %. The inertia check
-of the same protocol runs method A at G = 0.2, kappa_b_hat = 0.15 once more with the shear rate
-halved (Re = 0.1) at --inertia-radius (default the middle radius; 0 leaves it out). The BIM values beside them are read from the BIM runs with the
+is named (the spec's protocol), and D_inf is checked against the BIM: within 3 %. Two checks of the
+physics at one radius (--check-radius, default the smallest; 0 leaves them out), method A at
+G = 0.2, kappa_b_hat = 0.15 (the largest deformation): inertia, the spec's protocol, with the shear
+rate halved (Re = 0.1, particle Re 0.02), and confinement, the walls 16 R apart instead of 10 R with
+the same shear rate (Re scaled by 1.6, particle Re unchanged; the BIM has no walls). The BIM values beside them are read from the BIM runs with the
 same G, kappa_b_hat, method and 1280 triangles in --bim-work (default studies/shear, the
 folder of scripts/shear_study.py); missing BIM runs are run there with scripts/shear_study.py's
 naming, so the two studies share them.
@@ -31,10 +33,11 @@ again, an interrupted run continues from its checkpoint (--resume). --no-runs wr
 from what is in the work folder (finished runs; running or missing ones are listed as such).
 
 --jobs N runs N runs at once (each its own process; give them OMP_NUM_THREADS=1 on a machine of N
-cores): figure 15's methods first, then kappa_b_hat = 0, the inertia check last.
+cores): the two checks first (minutes at the smallest radius), then figure 15's methods, then
+kappa_b_hat = 0.
 
 Writes --doc (default docs/results/lbm.md) and its PNGs (docs/results/lbm/): the steady D of every
-case and radius with D_inf and the BIM, D against 1 / R, D against gamma t and the inertia check.
+case and radius with D_inf and the BIM, D against 1 / R, D against gamma t and the two checks.
 """
 import argparse
 import csv
@@ -63,6 +66,7 @@ TAU, REYNOLDS = 1.0, 0.2
 BOX = (8.0, 8.0, 10.0)
 FULL_BOX = (9.5, 9.5, 19.0)
 FULL_R = 13.5
+CHECK_HEIGHT = 16.0  # the confinement check's wall distance in R
 
 
 def fmt_g(x):
@@ -84,11 +88,13 @@ class LbmRun:
     def name(self):
         return (f"lbm_{self.method}_R{fmt_g(self.radius)}_mt1-{self.triangles}_G{fmt_g(self.G)}"
                 f"_kb{fmt_g(self.kappa_b)}_t{fmt_g(self.t_end)}"
-                + ("" if self.reynolds == REYNOLDS else f"_Re{fmt_g(self.reynolds)}"))
+                + ("" if self.reynolds == REYNOLDS else f"_Re{fmt_g(self.reynolds)}")
+                + ("" if self.box in (BOX, FULL_BOX) else f"_box{'x'.join(fmt_g(b) for b in self.box)}"))
 
     def label(self):
         return (f"LBM method {self.method:>4}, R = {fmt_g(self.radius):>4}, G = {fmt_g(self.G)}, kB_hat = {fmt_g(self.kappa_b)}"
-                + ("" if self.reynolds == REYNOLDS else f", Re = {fmt_g(self.reynolds)}"))
+                + ("" if self.reynolds == REYNOLDS else f", Re = {fmt_g(self.reynolds)}")
+                + ("" if self.box in (BOX, FULL_BOX) else f", box {' x '.join(fmt_g(b) for b in self.box)} R"))
 
     def nodes(self):
         return [math.floor(b * self.radius + 0.5) for b in self.box]  # as the solver rounds (half up)
@@ -317,9 +323,9 @@ def main():
     ap.add_argument("--bim-work", default=str(ROOT / "studies/shear"),
                     help="folder of the BIM runs, scripts/shear_study.py's")
     ap.add_argument("--doc", default=str(ROOT / "docs/results/lbm.md"))
-    ap.add_argument("--inertia-radius", type=float, default=None,
-                    help="radius of the inertia check (method A, G = 0.2, kB_hat = 0.15 with Re halved; "
-                         "default the middle of --radii, 0: none)")
+    ap.add_argument("--check-radius", type=float, default=None,
+                    help="radius of the inertia and confinement checks (method A, G = 0.2, kB_hat = 0.15; "
+                         "default the smallest of --radii, 0: none)")
     ap.add_argument("--jobs", type=int, default=1,
                     help="runs in parallel (default 1); run each with OMP_NUM_THREADS=1 when more than one")
     a = ap.parse_args()
@@ -338,11 +344,14 @@ def main():
         if a.full:
             runs += [LbmRun(m, G, kb, FULL_R, 5120, FULL_BOX, a.t_end) for m in METHODS]
             runs.append(LbmRun("none", G, 0.0, FULL_R, 5120, FULL_BOX, a.t_end))
-    # The spec's inertia check (LBM_IBM.md section 5): the shear rate halved (Re and Re_p halved) at
-    # one radius; D should not move.
-    inertia_radius = a.inertia_radius if a.inertia_radius is not None else sorted(radii)[len(radii) // 2]
-    if inertia_radius > 0:
-        runs.append(LbmRun("A", 0.2, 0.15, inertia_radius, 1280, BOX, a.t_end, REYNOLDS / 2))
+    # Checks at one radius, D should not move: the spec's inertia check (LBM_IBM.md section 5), the
+    # shear rate halved (Re and Re_p halved); confinement, the walls 16 R apart at the same shear
+    # rate (Re = R v / nu grows with the wall speed v = gamma H / 2).
+    check_radius = a.check_radius if a.check_radius is not None else min(radii)
+    if check_radius > 0:
+        runs.append(LbmRun("A", 0.2, 0.15, check_radius, 1280, BOX, a.t_end, REYNOLDS / 2))
+        wide = (BOX[0], BOX[1], CHECK_HEIGHT)
+        runs.append(LbmRun("A", 0.2, 0.15, check_radius, 1280, wide, a.t_end, REYNOLDS * CHECK_HEIGHT / BOX[2]))
     bim_runs = sorted({BimRun(r.method, r.G, r.kappa_b, a.t_end) for r in runs}, key=lambda b: b.name)
 
     # Cost per step, one probe per distinct lattice (the fluid dominates; method A's forces stand in).
@@ -378,14 +387,14 @@ def main():
 
     if not a.no_runs:
         # The BIM runs first: minutes each, and the column every LBM result is read against.
-        # Each run has its own folder, so runs in parallel share nothing. Figure 15's methods go
-        # first (in METHODS order, kappa_b = 0 last), the cheapest first within each; the inertia
-        # check last.
+        # Each run has its own folder, so runs in parallel share nothing. The checks go first (cheap,
+        # and they tell how far the extrapolation can be trusted), then figure 15's methods (in
+        # METHODS order, kappa_b = 0 last), the cheapest first within each.
         with ThreadPoolExecutor(max_workers=a.jobs) as pool:
             if not a.no_bim:
                 list(pool.map(lambda b: execute(b, bim_work / b.name, bendlab), bim_runs))
             rank = {m: i for i, m in enumerate(METHODS)}
-            ordered = sorted(runs, key=lambda r: (r.reynolds != REYNOLDS, rank.get(r.method, len(METHODS)),
+            ordered = sorted(runs, key=lambda r: (not is_check(r), rank.get(r.method, len(METHODS)),
                                                   r.steps() * math.prod(r.nodes()), r.name))
             list(pool.map(lambda r: execute(r, work / r.name, bendlab), ordered))
     write_doc(a, runs, bim_runs, work, bim_work, cost, projected, totals)
@@ -397,6 +406,11 @@ def rel(path):
         return str(Path(path).resolve().relative_to(ROOT))
     except ValueError:
         return str(path)
+
+
+def is_check(run):
+    """An inertia or confinement check (not part of the resolution study)."""
+    return run.reynolds != REYNOLDS or run.box not in (BOX, FULL_BOX)
 
 
 def save_figure(fig, ax, xlabel, ylabel, title, png, alt, title_size=None):
@@ -456,8 +470,8 @@ def write_doc(a, runs, bim_runs, work, bim_work, cost, projected, totals):
     L += ["", f"Projected time of the unfinished LBM runs, one after another: **{total / 3600:.1f} h** of wall time "
               f"at the measured load, **{total_cpu / 3600:.1f} h** of CPU time. Lattices not measured are scaled by",
           "node count from the largest measured one with as many triangles.", ""]
-    # Results (the inertia check has a table of its own below)
-    main_runs = [r for r in runs if r.reynolds == REYNOLDS]
+    # Results (the checks have a table of their own below)
+    main_runs = [r for r in runs if not is_check(r)]
     radii_all = sorted({r.radius for r in main_runs})
     L += ["## Steady deformation", "",
           "D_inf from D(R) = D_inf + a / R^p: through the last three radii (p fitted), or with p = 1 through",
@@ -538,22 +552,26 @@ def write_doc(a, runs, bim_runs, work, bim_work, cost, projected, totals):
         plt.close(fig)
     if conv:
         L += ["", "## Convergence in R", ""] + [c + "\n" for c in conv]
-    # Inertia check
-    inertia = [r for r in runs if r.reynolds != REYNOLDS]
-    if inertia:
-        L += ["", "## Inertia check", "",
-              "The spec's protocol (LBM_IBM.md section 5): the shear rate halved at one radius (Re and the",
-              "particle Reynolds number halved, everything else equal); D should not move.", "",
-              f"| G | kB_hat | method | R | D (Re = {fmt_g(REYNOLDS)}) | D (Re halved) | relative change |",
-              "|---|---|---|---|---|---|---|"]
-        for r in inertia:
-            base = LbmRun(r.method, r.G, r.kappa_b, r.radius, r.triangles, r.box, r.t_end)
+    # Checks
+    checks = [r for r in runs if is_check(r)]
+    if checks:
+        L += ["", "## Inertia and confinement checks", "",
+              "At one radius, method A, G = 0.2, kB_hat = 0.15 (the largest deformation), beside the same run",
+              f"in the study's setup (Re = {fmt_g(REYNOLDS)}, walls {fmt_g(BOX[2])} R apart): inertia, the spec's check, with",
+              "the shear rate halved (Re and the particle Re halved); confinement, the walls",
+              f"{fmt_g(CHECK_HEIGHT)} R apart at the same shear rate (Re scaled with the wall speed, particle Re",
+              "unchanged). The BIM's capsule is in unbounded shear.", "",
+              "| check | R | D (study setup) | D (check) | relative change |",
+              "|---|---|---|---|---|"]
+        for r in checks:
+            base = LbmRun(r.method, r.G, r.kappa_b, r.radius, r.triangles, BOX, r.t_end)
             s0, s1 = finished_summary(work / base.name, base), finished_summary(work / r.name, r)
             d0 = s0.get("D_steady") if s0 else None
             d1 = s1.get("D_steady") if s1 else None
-            L.append(f"| {fmt_g(r.G)} | {fmt_g(r.kappa_b)} | {r.method} | {fmt_g(r.radius)} | "
-                     + (f"{d0:.4f}" if d0 is not None else "-") + " | "
-                     + (f"{d1:.4f} (Re = {fmt_g(r.reynolds)})" if d1 is not None else "-") + " | "
+            what = (f"inertia: Re = {fmt_g(r.reynolds)}" if r.box == BOX else
+                    f"confinement: walls {fmt_g(r.box[2])} R apart, Re = {fmt_g(r.reynolds)}")
+            L.append(f"| {what} | {fmt_g(r.radius)} | " + (f"{d0:.4f}" if d0 is not None else "-") + " | "
+                     + (f"{d1:.4f}" if d1 is not None else "-") + " | "
                      + (f"{100 * (d1 / d0 - 1):+.2f} %" if d0 and d1 is not None else "-") + " |")
     L += ["", "A dash: the run has not finished. Partial runs (a time series but no summary) are drawn as far as",
           f"they got. The BIM column reads `{rel(bim_work)}` (scripts/shear_study.py's runs).", ""]
