@@ -282,7 +282,7 @@ def read_series(folder):
 
 def fit_extrapolation(radii, D):
     """D(R) = D_inf + a / R^p through three points (p from the ratio of differences), or with p = 1
-    through two. Returns (D_inf, a, p) or None."""
+    through two or where no p > 0 fits the three. Returns (D_inf, a, p, fitted) or None."""
     R = np.asarray(radii, float)
     D = np.asarray(D, float)
     if len(R) < 2:
@@ -301,11 +301,11 @@ def fit_extrapolation(radii, D):
                     lo, hi = (mid, hi) if f(lo) * f(mid) > 0 else (lo, mid)
                 p = 0.5 * (lo + hi)
                 a = (D[1] - D[2]) / (R[1] ** -p - R[2] ** -p)
-                return D[2] - a * R[2] ** -p, a, p
+                return D[2] - a * R[2] ** -p, a, p, True
     # p = 1, least squares over the points
     A = np.vstack([np.ones_like(R), 1 / R]).T
     (d_inf, a), *_ = np.linalg.lstsq(A, D, rcond=None)
-    return d_inf, a, 1.0
+    return d_inf, a, 1.0, False
 
 
 def main():
@@ -508,7 +508,8 @@ def write_doc(a, runs, bim_runs, work, bim_work, cost, projected, totals):
         if fit and bim_d:
             rel_dev = fit[0] / bim_d - 1
             dev = f"{100 * rel_dev:+.1f} %"
-            check = ("yes" if abs(rel_dev) <= 0.03 else "**no**") + ("" if len(pts) >= 3 else " (p = 1 assumed)")
+            check = ("yes" if abs(rel_dev) <= 0.03 else "**no**") + (
+                "" if fit[3] else " (p = 1 assumed)" if len(pts) < 3 else " (no p > 0 fits: p = 1, least squares)")
         fits[(G, kb, m)] = (pts, fit, bim_d)
         first = "-"
         if len(pts) >= 2:
