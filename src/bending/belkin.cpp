@@ -211,38 +211,25 @@ __attribute__((always_inline)) inline void grid_sum_body(const GridInput& in, co
   }
 }
 
-// grid_sum_body with the weights it stored (Store) read back: the same terms, summed in the same
-// order.
-template <Field Kind, int kGridLanes>
+// grid_sum_body for a scalar field with the weights it stored (Store) read back: the same terms,
+// summed in the same order. (Lap x is summed where the weights are stored.)
+template <int kGridLanes>
 __attribute__((always_inline)) inline void grid_cached_body(const GridInput& in, const int* runs, int nruns,
                                                             const double* __restrict wt, double* acc) {
-  const double *sx = in.sx, *sy = in.sy, *sz = in.sz, *w = in.w;
-  const double xi = in.xi, yi = in.yi, zi = in.zi, wi = in.wi;
-  double a0[kGridLanes] = {}, a1[kGridLanes] = {}, a2[kGridLanes] = {};
+  const double* w = in.w;
+  const double wi = in.wi;
+  double a0[kGridLanes] = {};
   for (int r = 0; r < nruns; ++r) {
     const std::int64_t k1 = runs[2 * r + 1];
     for (std::int64_t k0 = runs[2 * r]; k0 < k1; k0 += kGridLanes, wt += kGridLanes) {
 #pragma omp simd
       for (std::int64_t l = 0; l < kGridLanes; ++l) {
         const std::int64_t k = k0 + l;
-        const double weight = wt[l];
-        if constexpr (Kind == Field::scalar) {
-          a0[l] += weight * (w[k] - wi);
-        } else {
-          a0[l] += weight * (sx[k] - xi);
-          a1[l] += weight * (sy[k] - yi);
-          a2[l] += weight * (sz[k] - zi);
-        }
+        a0[l] += wt[l] * (w[k] - wi);
       }
     }
   }
-  for (int l = 0; l < kGridLanes; ++l) {
-    acc[0] += a0[l];
-    if constexpr (Kind == Field::positions) {
-      acc[1] += a1[l];
-      acc[2] += a2[l];
-    }
-  }
+  for (int l = 0; l < kGridLanes; ++l) acc[0] += a0[l];
 }
 
 // Compiled for AVX-512, AVX2+FMA and baseline x86-64 and picked at run time (as the boundary
@@ -280,26 +267,24 @@ using CachedKernel = void (*)(const GridInput&, const int*, int, const double*, 
   BENDLAB_KERNEL_CLONES void name(const GridInput& in, const int* runs, int nruns, double* out, double* acc) { \
     grid_sum_body<Field::positions, plane, lanes, true>(in, runs, nruns, acc, out);                            \
   }
-#define BENDLAB_CACHED_KERNEL(name, kind, lanes)                                                                   \
+#define BENDLAB_CACHED_KERNEL(name, lanes)                                                                         \
   BENDLAB_KERNEL_CLONES void name(const GridInput& in, const int* runs, int nruns, const double* wt, double* acc) { \
-    grid_cached_body<kind, lanes>(in, runs, nruns, wt, acc);                                                       \
+    grid_cached_body<lanes>(in, runs, nruns, wt, acc);                                                             \
   }
 BENDLAB_WEIGHT_KERNEL(grid_weights8, false, 8)
 BENDLAB_WEIGHT_KERNEL(grid_weights_plane8, true, 8)
 BENDLAB_WEIGHT_KERNEL(grid_weights4, false, 4)
 BENDLAB_WEIGHT_KERNEL(grid_weights_plane4, true, 4)
-BENDLAB_CACHED_KERNEL(grid_cached_scalar8, Field::scalar, 8)
-BENDLAB_CACHED_KERNEL(grid_cached_positions8, Field::positions, 8)
-BENDLAB_CACHED_KERNEL(grid_cached_scalar4, Field::scalar, 4)
-BENDLAB_CACHED_KERNEL(grid_cached_positions4, Field::positions, 4)
+BENDLAB_CACHED_KERNEL(grid_cached_scalar8, 8)
+BENDLAB_CACHED_KERNEL(grid_cached_scalar4, 4)
 #undef BENDLAB_WEIGHT_KERNEL
 #undef BENDLAB_CACHED_KERNEL
-// k[field][plane]: field 0 scalar, 1 positions; weights[plane]; cached[field]; the block width
+// k[field][plane]: field 0 scalar, 1 positions; weights[plane]; cached (scalar); the block width
 // (lanes) of the processor's widest vectors.
 struct GridKernels {
   GridKernel k[2][2];
   WeightKernel weights[2];
-  CachedKernel cached[2];
+  CachedKernel cached;
   int lanes;
 };
 const GridKernels& grid_kernels() {
@@ -311,11 +296,11 @@ const GridKernels& grid_kernels() {
 #endif
     return wide ? GridKernels{{{grid_sum_scalar8, grid_sum_scalar_plane8}, {grid_sum_positions8, grid_sum_positions_plane8}},
                               {grid_weights8, grid_weights_plane8},
-                              {grid_cached_scalar8, grid_cached_positions8},
+                              grid_cached_scalar8,
                               8}
                 : GridKernels{{{grid_sum_scalar4, grid_sum_scalar_plane4}, {grid_sum_positions4, grid_sum_positions_plane4}},
                               {grid_weights4, grid_weights_plane4},
-                              {grid_cached_scalar4, grid_cached_positions4},
+                              grid_cached_scalar4,
                               4};
   }();
   return kernels;
@@ -407,7 +392,7 @@ void BelkinLaplacian::cache_weights() {
   }
   if (start[n_] > options_.weight_cache_bytes / sizeof(double)) return;
   weight_start_ = std::move(start);
-  // Not zeroed: every entry is written below, each vertex's range by the thread that reads it later.
+  // Not zeroed: the pass below writes every entry before any apply reads it.
   const std::size_t need = std::max<std::size_t>(weight_start_[n_], 1);
   if (spare_weights.capacity >= need) {
     weights_.data = std::move(spare_weights.data);
@@ -601,8 +586,8 @@ void BelkinLaplacian::apply_grid(const double* w, double* const* out) const {
     double acc[3] = {0, 0, 0};
     const int* runs = runs_.data() + run_start_[i];
     const int nruns = (run_start_[i + 1] - run_start_[i]) / 2;
-    if (weights)
-      kernels.cached[w ? 0 : 1](in, runs, nruns, weights + weight_start_[i], acc);
+    if (weights && w)  // (with weights, Lap x was summed when they were stored: apply_to_positions)
+      kernels.cached(in, runs, nruns, weights + weight_start_[i], acc);
     else
       kernels.k[w ? 0 : 1][plane_test_[i] ? 1 : 0](in, runs, nruns, acc);
     const double a = kernel_area_[i];
