@@ -4,7 +4,7 @@ resolution study of shared/spec/LBM_IBM.md section 5.
 
     /usr/bin/python3 scripts/lbm_study.py [--radii 6,8,10] [--full] [--t-end T]
                                           [--measure-steps N] [--only-measure] [--no-runs] [--no-bim] [--jobs N]
-                                          [--check-radius R] [--bim-work DIR] [--work DIR] [--doc FILE] [--bendlab PATH]
+                                          [--check-radius R] [--spacing-check-radius R] [--bim-work DIR] [--work DIR] [--doc FILE] [--bendlab PATH]
 
 Cases: (G, kappa_b_hat) = (0.05, 0.0375) and (0.2, 0.15) with the paper's LBM methods A and B
 (figure 15), and kappa_b_hat = 0 at the same G, each at R = 6, 8, 10 lattice units (--radii), with
@@ -12,13 +12,19 @@ the same box in multiples of R (8 x 8 x 10, walls 10 R apart), tau = 1, Re = R v
 (particle Re = gamma R^2 / nu = 0.04) and 1280 triangles. --full adds the paper's own size:
 R = 13.5, 5120 triangles, box 9.5 R x 9.5 R x 19 R (128 x 128 x 257 nodes: 19 x 13.5 rounded up).
 
-For each case the steady D (gamma t in [5, 10]) is fitted as D(R) = D_inf + a / R^p (three radii
-determine D_inf, a and p; with two only p = 1 is assumed), and the smallest R within 2 % of D_inf
-is named (the spec's protocol), and D_inf is checked against the BIM: within 3 %. Two checks of the
+For each case the steady D (gamma t in [5, 10], with its standard error from five blocks of the
+window) is fitted as D(R) = D_inf + a / R^p (p fitted by least squares weighted by those errors
+through every radius; three radii determine D_inf, a and p; with two only p = 1 is assumed), with
+the 68 % range of D_inf when each D moves by its error, the smallest R within 2 % of D_inf is named
+(the spec's protocol), and D_inf is checked against the BIM: within 3 %. Two checks of the
 physics at one radius (--check-radius, default the smallest; 0 leaves them out), method A at
 G = 0.2, kappa_b_hat = 0.15 (the largest deformation): inertia, the spec's protocol, with the shear
 rate halved (Re = 0.1, particle Re 0.02), and confinement, the walls 16 R apart instead of 10 R with
-the same shear rate (Re scaled by 1.6, particle Re unchanged; the BIM has no walls). The BIM values beside them are read from the BIM runs with the
+the same shear rate (Re scaled by 1.6, particle Re unchanged; the BIM has no walls). A third,
+--spacing-check-radius R (default 0: none), runs method B at G = 0.2, kappa_b_hat = 0.15 with 5120
+triangles at radius R: the same marker spacing in lattice units as 1280 triangles at R / 2, which
+tells whether the spacing of the membrane's nodes (1280 triangles: 0.15 R, above dx from R = 7) is
+part of the error in R. The BIM values beside them are read from the BIM runs with the
 same G, kappa_b_hat, method and 1280 triangles in --bim-work (default studies/shear, the
 folder of scripts/shear_study.py); missing BIM runs are run there with scripts/shear_study.py's
 naming, so the two studies share them.
@@ -280,32 +286,71 @@ def read_series(folder):
     return {k: np.array([float(r[k]) for r in rows]) for k in ("gamma_t", "D")} if rows else None
 
 
-def fit_extrapolation(radii, D):
-    """D(R) = D_inf + a / R^p through three points (p from the ratio of differences), or with p = 1
-    through two or where no p > 0 fits the three. Returns (D_inf, a, p, fitted) or None."""
+def steady_uncertainty(folder, t_end, blocks=5):
+    """Standard error of the steady D from its time series: the steady window (gamma t in [5, 10],
+    include/bendlab/capsule/steady_statistics.hpp) cut into `blocks` equal blocks, the standard
+    deviation of the block means over sqrt(blocks). None without a full window."""
+    ser = read_series(folder)
+    lo, hi = (5.0, 10.0) if t_end >= 10 else (t_end / 2, t_end)
+    if ser is None or ser["gamma_t"][-1] < hi - 1e-9:
+        return None
+    t, D = ser["gamma_t"], ser["D"]
+    edges = np.linspace(lo, hi, blocks + 1)
+    means = [D[(t >= edges[i]) & (t <= edges[i + 1] + 1e-12)].mean() for i in range(blocks)]
+    return float(np.std(means, ddof=1) / math.sqrt(blocks))
+
+
+def fit_power(R, D, w, p):
+    """D_inf and a of D = D_inf + a / R^p by weighted least squares at a given p, and chi^2."""
+    A = np.vstack([np.ones_like(R), R ** -p]).T * w[:, None]
+    (d_inf, a), *_ = np.linalg.lstsq(A, D * w, rcond=None)
+    r = (d_inf + a * R ** -p - D) * w
+    return d_inf, a, float(r @ r)
+
+
+def fit_extrapolation(radii, D, sigma=None):
+    """D(R) = D_inf + a / R^p through every radius, p fitted (weighted least squares, weights 1 /
+    sigma; through three radii the curve passes through all three), or with p = 1 through two or
+    where no p in [0.05, 8] fits better than its ends (p runs off: no power law fits).
+    Returns (D_inf, a, p, fitted, chi2) or None."""
     R = np.asarray(radii, float)
     D = np.asarray(D, float)
     if len(R) < 2:
         return None
+    w = np.ones_like(R) if sigma is None else 1 / np.asarray(sigma, float)
     if len(R) >= 3:
-        R, D = R[-3:], D[-3:]
-        ratio = (D[0] - D[1]) / (D[1] - D[2]) if D[1] != D[2] else math.nan
+        ps = np.exp(np.linspace(math.log(0.05), math.log(8.0), 80))
+        chi = [fit_power(R, D, w, p)[2] for p in ps]
+        i = int(np.argmin(chi))
+        if 0 < i < len(ps) - 1:
+            lo, hi = ps[i - 1], ps[i + 1]
+            for _ in range(60):  # golden section on the bracketed minimum (to 1e-12 of p)
+                m1, m2 = hi - 0.618 * (hi - lo), lo + 0.618 * (hi - lo)
+                if fit_power(R, D, w, m1)[2] < fit_power(R, D, w, m2)[2]:
+                    hi = m2
+                else:
+                    lo = m1
+            p = 0.5 * (lo + hi)
+            d_inf, a, chi2 = fit_power(R, D, w, p)
+            return d_inf, a, p, True, chi2
+    d_inf, a, chi2 = fit_power(R, D, w, 1.0)
+    return d_inf, a, 1.0, False, chi2
 
-        def f(p):
-            return (R[0] ** -p - R[1] ** -p) / (R[1] ** -p - R[2] ** -p) - ratio
-        if math.isfinite(ratio) and ratio > 0:
-            lo, hi = 0.05, 8.0
-            if f(lo) * f(hi) < 0:
-                for _ in range(200):
-                    mid = 0.5 * (lo + hi)
-                    lo, hi = (mid, hi) if f(lo) * f(mid) > 0 else (lo, mid)
-                p = 0.5 * (lo + hi)
-                a = (D[1] - D[2]) / (R[1] ** -p - R[2] ** -p)
-                return D[2] - a * R[2] ** -p, a, p, True
-    # p = 1, least squares over the points
-    A = np.vstack([np.ones_like(R), 1 / R]).T
-    (d_inf, a), *_ = np.linalg.lstsq(A, D, rcond=None)
-    return d_inf, a, 1.0, False
+
+def extrapolation_spread(radii, D, sigma, draws=400, seed=1):
+    """16th and 84th percentiles of D_inf when each D moves by its standard error (normal, seeded):
+    how far the fit can be trusted. None without a sigma for every point."""
+    if sigma is None or any(s is None or not s > 0 for s in sigma) or len(radii) < 3:
+        return None
+    rng = np.random.default_rng(seed)
+    out = []
+    for _ in range(draws):
+        f = fit_extrapolation(radii, np.asarray(D) + rng.normal(0, sigma), sigma)
+        if f and f[3]:
+            out.append(f[0])
+    if len(out) < draws // 2:
+        return None
+    return float(np.percentile(out, 16)), float(np.percentile(out, 84))
 
 
 def main():
@@ -326,6 +371,9 @@ def main():
     ap.add_argument("--check-radius", type=float, default=None,
                     help="radius of the inertia and confinement checks (method A, G = 0.2, kB_hat = 0.15; "
                          "default the smallest of --radii, 0: none)")
+    ap.add_argument("--spacing-check-radius", type=float, default=0.0,
+                    help="radius of the marker-spacing check (method B, G = 0.2, kB_hat = 0.15, 5120 triangles; "
+                         "default 0: none)")
     ap.add_argument("--jobs", type=int, default=1,
                     help="runs in parallel (default 1); run each with OMP_NUM_THREADS=1 when more than one")
     a = ap.parse_args()
@@ -352,6 +400,8 @@ def main():
         runs.append(LbmRun("A", 0.2, 0.15, check_radius, 1280, BOX, a.t_end, REYNOLDS / 2))
         wide = (BOX[0], BOX[1], CHECK_HEIGHT)
         runs.append(LbmRun("A", 0.2, 0.15, check_radius, 1280, wide, a.t_end, REYNOLDS * CHECK_HEIGHT / BOX[2]))
+    if a.spacing_check_radius > 0:
+        runs.append(LbmRun("B", 0.2, 0.15, a.spacing_check_radius, 5120, BOX, a.t_end))
     bim_runs = sorted({BimRun(r.method, r.G, r.kappa_b, a.t_end) for r in runs}, key=lambda b: b.name)
 
     # Cost per step, one probe per distinct lattice (the fluid dominates; method A's forces stand in).
@@ -400,6 +450,11 @@ def main():
     write_doc(a, runs, bim_runs, work, bim_work, cost, projected, totals)
 
 
+def with_error(value, err):
+    """0.21861(10): the value with its standard error in units of its last digit (5 decimals)."""
+    return f"{value:.5f}" + (f"({max(1, round(err * 1e5))})" if err is not None else "")
+
+
 def rel(path):
     """A folder as the document names it: relative to the repository when it lies inside."""
     try:
@@ -409,8 +464,8 @@ def rel(path):
 
 
 def is_check(run):
-    """An inertia or confinement check (not part of the resolution study)."""
-    return run.reynolds != REYNOLDS or run.box not in (BOX, FULL_BOX)
+    """An inertia, confinement or marker-spacing check (not part of the resolution study)."""
+    return run.reynolds != REYNOLDS or run.box not in (BOX, FULL_BOX) or (run.box == BOX and run.triangles != 1280)
 
 
 def save_figure(fig, ax, xlabel, ylabel, title, png, alt, title_size=None):
@@ -474,28 +529,37 @@ def write_doc(a, runs, bim_runs, work, bim_work, cost, projected, totals):
     main_runs = [r for r in runs if not is_check(r)]
     radii_all = sorted({r.radius for r in main_runs})
     L += ["## Steady deformation", "",
-          "D_inf from D(R) = D_inf + a / R^p: through the last three radii (p fitted), or with p = 1 through",
-          "two. The check of the issue: D_inf within 3 % of the project's BIM at 1280 triangles. How much",
-          "the fitted p decides it: the column p = 1 extrapolates the last two radii with the first-order",
-          "convergence expected of the immersed boundary (its kernel shifts the surface by a fraction of",
-          "dx); with the differences between radii here (2e-3 to 9e-3), a change of 1e-4 in one D moves a",
-          "fitted p of about 1 by 0.05 to 0.15.", "",
+          "Each D is the mean over gamma t in [5, 10] with its standard error in units of the last digit",
+          "(the window cut into five blocks: the spread of the block means over sqrt(5)). D_inf from",
+          "D(R) = D_inf + a / R^p, p fitted by least squares weighted by those errors through every radius",
+          "(through three radii the curve passes through all three; with two, p = 1). Its 68 % range: the",
+          "fit repeated with each D moved by its error (400 seeded normal draws). chi2: the weighted sum of",
+          "squared residuals (1 degree of freedom per radius beyond three; about 1 each when the power law",
+          "holds). The check of the issue: D_inf within 3 % of the project's BIM at 1280 triangles. The",
+          "column p = 1 extrapolates the last two radii with the first-order convergence expected of the",
+          "immersed boundary (its kernel shifts the surface by a fraction of dx).", "",
           "| G | kB_hat | method | " + " | ".join(f"D (R = {fmt_g(R)})" for R in radii_all)
-          + " | D_inf (p) | smallest R within 2 % | BIM 1280 | D_inf / BIM - 1 | within 3 % | D_inf, p = 1 (vs BIM) |",
-          "|---|---|---|" + "---|" * (len(radii_all) + 6)]
+          + " | D_inf (p) | 68 % range | chi2 | smallest R within 2 % | BIM 1280 | D_inf / BIM - 1 | within 3 % | D_inf, p = 1 (vs BIM) |",
+          "|---|---|---|" + "---|" * (len(radii_all) + 8)]
     cases = sorted({(r.G, r.kappa_b, r.method) for r in main_runs})
     figs, fits = [], {}
     for (G, kb, m) in cases:
         rs = sorted([r for r in main_runs if (r.G, r.kappa_b, r.method) == (G, kb, m) and r.triangles == 1280],
                     key=lambda r: r.radius)
-        cells, pts = [], []
+        cells, pts, sig = [], [], []
         for r in sorted([r for r in main_runs if (r.G, r.kappa_b, r.method) == (G, kb, m)], key=lambda r: r.radius):
             s = finished_summary(work / r.name, r)
-            cells.append(f"{s['D_steady']:.4f}" if s and s.get("D_steady") is not None else "-")
+            err = steady_uncertainty(work / r.name, r.t_end) if s else None
+            cells.append(with_error(s["D_steady"], err) if s and s.get("D_steady") is not None else "-")
             if s and s.get("D_steady") is not None and r in rs:
                 pts.append((r.radius, s["D_steady"]))
-        fit = fit_extrapolation([p[0] for p in pts], [p[1] for p in pts]) if len(pts) >= 2 else None
+                sig.append(err)
+        weights = sig if pts and all(e and e > 0 for e in sig) else None
+        fit = fit_extrapolation([p[0] for p in pts], [p[1] for p in pts], weights) if len(pts) >= 2 else None
         fit_cell = f"{fit[0]:.4f} ({fit[2]:.2f})" if fit else "needs 2 radii"
+        spread = extrapolation_spread([p[0] for p in pts], [p[1] for p in pts], weights) if fit else None
+        spread_cell = f"{spread[0]:.4f} - {spread[1]:.4f}" if spread else "-"
+        chi_cell = f"{fit[4]:.2f}" if fit and len(pts) > 3 and weights else "-"
         within = "-"
         if fit:
             ok = [R for R, D in pts if abs(D - fit[0]) <= 0.02 * abs(fit[0])]
@@ -508,6 +572,8 @@ def write_doc(a, runs, bim_runs, work, bim_work, cost, projected, totals):
         if fit and bim_d:
             rel_dev = fit[0] / bim_d - 1
             dev = f"{100 * rel_dev:+.1f} %"
+            if spread:
+                dev += f" ({100 * (spread[0] / bim_d - 1):+.1f} to {100 * (spread[1] / bim_d - 1):+.1f} %)"
             check = ("yes" if abs(rel_dev) <= 0.03 else "**no**") + (
                 "" if fit[3] else " (p = 1 assumed)" if len(pts) < 3 else " (no p > 0 fits: p = 1, least squares)")
         fits[(G, kb, m)] = (pts, fit, bim_d)
@@ -517,7 +583,7 @@ def write_doc(a, runs, bim_runs, work, bim_work, cost, projected, totals):
             d_first = D2 - (D1 - D2) / (1 / R1 - 1 / R2) / R2
             first = f"{d_first:.4f}" + (f" ({100 * (d_first / bim_d - 1):+.1f} %)" if bim_d else "")
         L.append(f"| {fmt_g(G)} | {fmt_g(kb)} | {m} | " + " | ".join(cells)
-                 + f" | {fit_cell} | {within} | {bim} | {dev} | {check} | {first} |")
+                 + f" | {fit_cell} | {spread_cell} | {chi_cell} | {within} | {bim} | {dev} | {check} | {first} |")
         # figure: D(gamma t), LBM at each R beside the BIM
         fig, ax = plt.subplots(figsize=(5.5, 3.6))
         any_line = False
@@ -565,20 +631,23 @@ def write_doc(a, runs, bim_runs, work, bim_work, cost, projected, totals):
     # Checks
     checks = [r for r in runs if is_check(r)]
     if checks:
-        L += ["", "## Inertia and confinement checks", "",
+        L += ["", "## Inertia, confinement and marker-spacing checks", "",
               "At one radius, method A, G = 0.2, kB_hat = 0.15 (the largest deformation), beside the same run",
               f"in the study's setup (Re = {fmt_g(REYNOLDS)}, walls {fmt_g(BOX[2])} R apart): inertia, the spec's check, with",
               "the shear rate halved (Re and the particle Re halved); confinement, the walls",
               f"{fmt_g(CHECK_HEIGHT)} R apart at the same shear rate (Re scaled with the wall speed, particle Re",
-              "unchanged). The BIM's capsule is in unbounded shear.", "",
+              "unchanged). The BIM's capsule is in unbounded shear. Marker spacing (where run): method B at",
+              "G = 0.2, kB_hat = 0.15 with 5120 triangles instead of 1280, the nodes' spacing halved (1280",
+              "triangles: edges of about 0.15 R, so above dx from R = 7).", "",
               "| check | R | D (study setup) | D (check) | relative change |",
               "|---|---|---|---|---|"]
         for r in checks:
-            base = LbmRun(r.method, r.G, r.kappa_b, r.radius, r.triangles, BOX, r.t_end)
+            base = LbmRun(r.method, r.G, r.kappa_b, r.radius, 1280, BOX, r.t_end)
             s0, s1 = finished_summary(work / base.name, base), finished_summary(work / r.name, r)
             d0 = s0.get("D_steady") if s0 else None
             d1 = s1.get("D_steady") if s1 else None
-            what = (f"inertia: Re = {fmt_g(r.reynolds)}" if r.box == BOX else
+            what = (f"marker spacing: method {r.method}, {r.triangles} triangles" if r.triangles != 1280 else
+                    f"inertia: Re = {fmt_g(r.reynolds)}" if r.box == BOX else
                     f"confinement: walls {fmt_g(r.box[2])} R apart, Re = {fmt_g(r.reynolds)}")
             L.append(f"| {what} | {fmt_g(r.radius)} | " + (f"{d0:.4f}" if d0 is not None else "-") + " | "
                      + (f"{d1:.4f}" if d1 is not None else "-") + " | "

@@ -1,0 +1,92 @@
+"""The resolution study's extrapolation (scripts/lbm_study.py): D(R) = D_inf + a / R^p fitted
+through the radii, its spread under the runs' errors, and the block error of a steady mean.
+Exact power laws must come back exactly; synthetic series with known statistics give their error."""
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "scripts"))
+import lbm_study  # noqa: E402
+
+
+def power_law(R, d_inf, a, p):
+    return d_inf + a * np.asarray(R, float) ** -p
+
+
+@pytest.mark.parametrize("p", [0.5, 1.0, 1.7, 2.5])
+def test_three_radii_recover_an_exact_power_law(p):
+    R = [6.0, 8.0, 10.0]
+    d_inf, a, p_fit, fitted, chi2 = lbm_study.fit_extrapolation(R, power_law(R, 0.21, 0.09, p))
+    assert fitted
+    assert p_fit == pytest.approx(p, rel=1e-6)
+    assert d_inf == pytest.approx(0.21, abs=1e-9)
+    assert a == pytest.approx(0.09, rel=1e-6)
+    assert chi2 < 1e-20
+
+
+def test_more_radii_weighted_fit_recovers_the_law_and_ignores_scaled_weights():
+    R = [6.0, 7.0, 8.0, 10.0, 12.0]
+    D = power_law(R, 0.5, -0.2, 1.3)
+    sigma = [1e-4, 2e-4, 1e-4, 5e-5, 3e-5]
+    f1 = lbm_study.fit_extrapolation(R, D, sigma)
+    f2 = lbm_study.fit_extrapolation(R, D, [10 * s for s in sigma])
+    assert f1[3] and f1[2] == pytest.approx(1.3, rel=1e-5)
+    assert f1[0] == pytest.approx(0.5, abs=1e-8)
+    assert f2[0] == pytest.approx(f1[0], abs=1e-10)
+
+
+def test_chi2_counts_residuals_in_units_of_the_errors():
+    # Four radii on a law, one point moved by 3 sigma: the least-squares chi^2 is positive and
+    # below 9 (the fit absorbs part of the move).
+    R = [6.0, 8.0, 10.0, 12.0]
+    sigma = np.full(4, 1e-4)
+    D = power_law(R, 0.2, 0.06, 1.0)
+    D[1] += 3e-4
+    chi2 = lbm_study.fit_extrapolation(R, D, sigma)[4]
+    assert 0 < chi2 < 9
+
+
+def test_two_radii_assume_first_order():
+    R = [8.0, 10.0]
+    d_inf, a, p, fitted, _ = lbm_study.fit_extrapolation(R, power_law(R, 0.3, 0.1, 1.0))
+    assert not fitted and p == 1.0
+    assert d_inf == pytest.approx(0.3, abs=1e-12)
+
+
+def test_no_power_law_when_d_moves_the_same_amount_each_step():
+    # Equal steps in R are no power law in R with p > 0: the fit falls back to p = 1.
+    R = [6.0, 8.0, 10.0]
+    assert not lbm_study.fit_extrapolation(R, [0.278, 0.276, 0.274])[3]
+
+
+def test_spread_is_narrow_for_precise_points_and_brackets_the_fit():
+    R = [6.0, 8.0, 10.0, 12.0]
+    D = power_law(R, 0.2, 0.06, 1.0)
+    lo, hi = lbm_study.extrapolation_spread(R, D, [1e-7] * 4)
+    assert lo <= 0.2 <= hi and hi - lo < 1e-4
+    wide = lbm_study.extrapolation_spread(R, D, [1e-4] * 4)
+    assert wide[1] - wide[0] > hi - lo
+    assert lbm_study.extrapolation_spread(R, D, None) is None
+
+
+def test_block_error_of_a_steady_mean(tmp_path):
+    # D = c + alternating +-e per block of the window [5, 10]: the block means are c +- e, so the
+    # standard error is std([c+e, c-e, c+e, c-e, c+e], ddof=1) / sqrt(5).
+    t = np.linspace(0.0, 10.0, 10001)
+    block = np.clip(np.floor(t - 5.0), 0, 4).astype(int)
+    e, c = 1e-3, 0.25
+    D = c + np.where(block % 2 == 0, e, -e)
+    with open(tmp_path / "timeseries.csv", "w") as f:
+        f.write("gamma_t,D\n")
+        for ti, di in zip(t, D):
+            f.write(f"{ti:.6f},{di:.12f}\n")
+    means = [c + e, c - e, c + e, c - e, c + e]
+    expected = np.std(means, ddof=1) / math.sqrt(5)
+    got = lbm_study.steady_uncertainty(tmp_path, 10.0)
+    assert got == pytest.approx(expected, rel=2e-3)
+    with open(tmp_path / "timeseries.csv", "w") as f:  # a run stopped at gamma t = 8: no full window
+        f.write("gamma_t,D\n" + "".join(f"{ti:.6f},{di:.12f}\n" for ti, di in zip(t, D) if ti <= 8.0))
+    assert lbm_study.steady_uncertainty(tmp_path, 10.0) is None
