@@ -1,22 +1,26 @@
 #!/usr/bin/python3
 """The lattice Boltzmann fluid step against the machine's memory bandwidth (issue: LBM benchmark).
 
-    /usr/bin/python3 scripts/make_lbm_performance_doc.py [--bench build/release/bench_lbm]
-                                                         [--json FILE] [--out docs/results/lbm_performance.md]
+    /usr/bin/python3 scripts/make_lbm_performance_doc.py [--bench build/release/bench_lbm] [--runs N]
+                                                         [--json FILE ...] [--out docs/results/lbm_performance.md]
 
-Runs bench/bench_lbm.cpp (Google Benchmark, JSON) once, or reads an earlier report with --json,
-and writes the table of the fluid step's MLUPS on 1 and 2 threads for the 128^3 box between
+Runs bench/bench_lbm.cpp (Google Benchmark, JSON) --runs times (default 5, each a fresh process),
+or reads earlier reports with --json, and writes the table of the fluid step's MLUPS on 1 and 2 threads for the 128^3 box between
 moving walls beside the STREAM-like triad measured in the same run, the fraction of the layout's
 bandwidth bound reached (328 bytes per node update: 19 + 19 doubles of populations read and
 written in place by the AA pattern, 3 force components read), and the membrane + immersed-boundary
 cost of the paper's full-size capsule (5120 triangles, R = 13.5) per step as a fraction of the
-fluid step. The load average before and after the run is recorded: on a shared machine the
-figures are only as good as the quiet they were taken in. Standard library only.
+fluid step. Every figure is the median over the runs, and the fraction of the bound is the median
+of the fractions each run measured against its own triad (bandwidth and kernel paired in time),
+shown with its range over the runs: on a shared machine (memory bandwidth shared with other
+guests) one run can differ from the next by a third. The load average before and after is
+recorded. Standard library only.
 """
 import argparse
 import datetime
 import json
 import os
+import statistics
 import subprocess
 import sys
 
@@ -26,44 +30,62 @@ def load_average():
         return " ".join(f.read().split()[:3])
 
 
-def rows(report, family):
+def rows(reports, family):
+    """{threads: {field: median over the reports}}, with "<field>_all" holding every report's value."""
+    values = {}
+    for report in reports:
+        for b in report["benchmarks"]:
+            parts = b["name"].split("/")
+            if parts[0] == family:
+                row = values.setdefault(int(parts[1]), {})
+                for k, v in b.items():
+                    if isinstance(v, (int, float)):
+                        row.setdefault(k, []).append(float(v))
+                    else:
+                        row[k] = [v]
     out = {}
-    for b in report["benchmarks"]:
-        parts = b["name"].split("/")
-        if parts[0] == family:
-            out[int(parts[1])] = b
+    for t, row in values.items():
+        out[t] = {k: (statistics.median(v) if isinstance(v[0], float) else v[0]) for k, v in row.items()}
+        out[t].update({k + "_all": v for k, v in row.items() if isinstance(v[0], float)})
     return out
 
 
 def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--bench", default="build/release/bench_lbm")
-    p.add_argument("--json", help="read this bench_lbm JSON report instead of running the benchmark")
+    p.add_argument("--runs", type=int, default=5, help="runs of the benchmark (default 5)")
+    p.add_argument("--json", nargs="+", help="read these bench_lbm JSON reports instead of running the benchmark")
     p.add_argument("--out", default="docs/results/lbm_performance.md")
     a = p.parse_args()
 
     load_before = load_after = "not measured (report read from --json)"
+    reports = []
     if a.json:
-        with open(a.json) as f:
-            report = json.load(f)
+        for path in a.json:
+            with open(path) as f:
+                reports.append(json.load(f))
     else:
+        if a.runs < 1:
+            sys.exit("make_lbm_performance_doc: --runs must be at least 1")
         if not os.access(a.bench, os.X_OK):
             sys.exit(f"make_lbm_performance_doc: no benchmark program at {a.bench} (build the release preset)")
         load_before = load_average()
-        run = subprocess.run([a.bench, "--benchmark_format=json"], capture_output=True, text=True)
+        for i in range(a.runs):
+            print(f"make_lbm_performance_doc: run {i + 1} of {a.runs}", flush=True)
+            run = subprocess.run([a.bench, "--benchmark_format=json"], capture_output=True, text=True)
+            if run.returncode != 0:
+                sys.exit(f"make_lbm_performance_doc: {a.bench} failed:\n{run.stderr}")
+            reports.append(json.loads(run.stdout))
         load_after = load_average()
-        if run.returncode != 0:
-            sys.exit(f"make_lbm_performance_doc: {a.bench} failed:\n{run.stderr}")
-        report = json.loads(run.stdout)
 
-    ctx = report.get("context", {})
-    triad = rows(report, "BM_StreamTriad")
-    copy = rows(report, "BM_StreamCopy")
-    bgk = rows(report, "BM_LbmStepBGK")
-    reg = rows(report, "BM_LbmStepRegularized")
-    bgk_plain = rows(report, "BM_LbmStepBGKUnpadded")
-    reg_plain = rows(report, "BM_LbmStepRegularizedUnpadded")
-    ibm = rows(report, "BM_MembraneIbm")
+    ctx = reports[0].get("context", {})
+    triad = rows(reports, "BM_StreamTriad")
+    copy = rows(reports, "BM_StreamCopy")
+    bgk = rows(reports, "BM_LbmStepBGK")
+    reg = rows(reports, "BM_LbmStepRegularized")
+    bgk_plain = rows(reports, "BM_LbmStepBGKUnpadded")
+    reg_plain = rows(reports, "BM_LbmStepRegularizedUnpadded")
+    ibm = rows(reports, "BM_MembraneIbm")
     if not triad or not bgk:
         sys.exit("make_lbm_performance_doc: the report has no BM_StreamTriad or BM_LbmStepBGK rows")
 
@@ -71,7 +93,11 @@ def main():
         "# Lattice Boltzmann fluid step against the memory bandwidth",
         "",
         "Generated by `/usr/bin/python3 scripts/make_lbm_performance_doc.py` (do not edit by hand), which runs",
-        "`build/release/bench_lbm` (bench/bench_lbm.cpp) once: every figure below comes from that one run.",
+        f"`build/release/bench_lbm` (bench/bench_lbm.cpp) {len(reports)} times: every figure below is the median over",
+        "those runs; the fraction of the bound is the median of each run's kernel against its own triad",
+        "(the range over the runs beside it: the memory bandwidth of this machine is shared and moves",
+        "from run to run; a fraction above 1 in the range is a run whose triad met less bandwidth than",
+        "its kernel a few seconds later).",
         "",
         "```",
         f"date: {ctx.get('date', datetime.datetime.utcnow().isoformat())}",
@@ -86,7 +112,7 @@ def main():
         "line fill of the target (32 bytes per element: the traffic the memory sees). Box: 128^3 nodes",
         "between moving walls (shear flow).",
         "",
-        "| threads | copy traffic (GB/s) | triad traffic (GB/s) | collision | MLUPS | GB/s at 328 B | fraction of the bound | target 0.7 |",
+        "| threads | copy traffic (GB/s) | triad traffic (GB/s) | collision | MLUPS | GB/s at 328 B | fraction of the bound (range) | target 0.7 |",
         "|---|---|---|---|---|---|---|---|",
     ]
     for t in sorted(bgk):
@@ -95,14 +121,16 @@ def main():
                 continue
             b = table[t]
             frac = b.get("bound_fraction", float("nan"))
+            every = b.get("bound_fraction_all", [frac])
             lines.append(
                 f"| {t} | {copy[t]['traffic_GBps']:.1f} | {triad[t]['traffic_GBps']:.1f} | {name} | "
-                f"{b['MLUPS']:.1f} | {b['GBps']:.1f} | {frac:.2f} | {'met' if frac >= 0.7 else '**not met**'} |")
+                f"{b['MLUPS']:.1f} | {b['GBps']:.1f} | {frac:.2f} ({min(every):.2f} - {max(every):.2f}) | "
+                f"{'met' if frac >= 0.7 else '**not met**'} |")
     if bgk_plain or reg_plain:
         lines += [
             "",
             "The padded store against the plain one (LatticeConfig::pad_slots = false: the 19 slots and 3 force",
-            "components num_nodes() apart, a power of two at 128^3), same run:",
+            "components num_nodes() apart, a power of two at 128^3), same runs:",
             "",
             "| threads | collision | MLUPS, padded | MLUPS, plain | padded / plain |",
             "|---|---|---|---|---|",
