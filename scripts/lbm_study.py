@@ -4,7 +4,8 @@ resolution study of shared/spec/LBM_IBM.md section 5.
 
     /usr/bin/python3 scripts/lbm_study.py [--radii 6,8,10] [--full] [--t-end T]
                                           [--measure-steps N] [--only-measure] [--no-runs] [--no-bim] [--jobs N]
-                                          [--check-radius R] [--spacing-check-radius R] [--bim-work DIR] [--work DIR] [--doc FILE] [--bendlab PATH]
+                                          [--check-radius R] [--fine-radii R,...] [--fine-cases M:G,...]
+                                          [--bim-work DIR] [--work DIR] [--doc FILE] [--bendlab PATH]
 
 Cases: (G, kappa_b_hat) = (0.05, 0.0375) and (0.2, 0.15) with the paper's LBM methods A and B
 (figure 15), and kappa_b_hat = 0 at the same G, each at R = 6, 8, 10 lattice units (--radii), with
@@ -16,15 +17,15 @@ For each case the steady D (gamma t in [5, 10], with its standard error from fiv
 window) is fitted as D(R) = D_inf + a / R^p (p fitted by least squares weighted by those errors
 through every radius; three radii determine D_inf, a and p; with two only p = 1 is assumed), with
 the 68 % range of D_inf when each D moves by its error, the smallest R within 2 % of D_inf is named
-(the spec's protocol), and D_inf is checked against the BIM: within 3 %. Two checks of the
+(the spec's protocol), and D_inf is checked against the BIM: within 3 %. --fine-radii R,... adds
+the same study with 5120 triangles for the cases of --fine-cases (default B:0.2, method B at
+G = 0.2): the spacing of the membrane's nodes halved (1280 triangles: edges of about 0.15 R, above
+dx from R = 7; 5120: below dx up to R = 13), against the BIM at 5120 triangles (scripts/
+shear_study.py part (e)'s run: RKC, tree quadrature) and at 1280. Two checks of the
 physics at one radius (--check-radius, default the smallest; 0 leaves them out), method A at
 G = 0.2, kappa_b_hat = 0.15 (the largest deformation): inertia, the spec's protocol, with the shear
 rate halved (Re = 0.1, particle Re 0.02), and confinement, the walls 16 R apart instead of 10 R with
-the same shear rate (Re scaled by 1.6, particle Re unchanged; the BIM has no walls). A third,
---spacing-check-radius R (default 0: none), runs method B at G = 0.2, kappa_b_hat = 0.15 with 5120
-triangles at radius R: the same marker spacing in lattice units as 1280 triangles at R / 2, which
-tells whether the spacing of the membrane's nodes (1280 triangles: 0.15 R, above dx from R = 7) is
-part of the error in R. The BIM values beside them are read from the BIM runs with the
+the same shear rate (Re scaled by 1.6, particle Re unchanged; the BIM has no walls). The BIM values beside them are read from the BIM runs with the
 same G, kappa_b_hat, method and 1280 triangles in --bim-work (default studies/shear, the
 folder of scripts/shear_study.py); missing BIM runs are run there with scripts/shear_study.py's
 naming, so the two studies share them.
@@ -73,6 +74,7 @@ BOX = (8.0, 8.0, 10.0)
 FULL_BOX = (9.5, 9.5, 19.0)
 FULL_R = 13.5
 CHECK_HEIGHT = 16.0  # the confinement check's wall distance in R
+FINE_TRIANGLES = 5120  # the --fine-radii series: the nodes' spacing halved
 
 
 def fmt_g(x):
@@ -134,12 +136,15 @@ class BimRun:
     @property
     def name(self):
         return (f"{self.method}_mt1-{self.triangles}_G{fmt_g(self.G)}_kb{fmt_g(self.kappa_b)}"
-                f"_t{fmt_g(self.t_end)}")
+                f"_t{fmt_g(self.t_end)}" + ("_rkc_tree" if self.triangles == FINE_TRIANGLES else ""))
 
     def arguments(self, out):
+        # 5120 triangles as part (e) of scripts/shear_study.py runs them (RKC, the tree quadrature),
+        # 1280 as its parts (a)-(c) (Cash-Karp, every triangle by the 7-point rule).
         return ["shear", "--method", self.method, "--mesh", f"mt1:{self.triangles}", "--G", fmt_g(self.G),
                 "--kappa-b-hat", fmt_g(self.kappa_b), "--t-end", fmt_g(self.t_end), "--out", str(out),
-                "--no-plot"]
+                "--no-plot"] + (["--integrator", "rkc", "--rtol", "1e-7", "--atol", "1e-6",
+                                 "--bim-quadrature", "tree"] if self.triangles == FINE_TRIANGLES else [])
 
 
 def close(a, b):
@@ -371,9 +376,11 @@ def main():
     ap.add_argument("--check-radius", type=float, default=None,
                     help="radius of the inertia and confinement checks (method A, G = 0.2, kB_hat = 0.15; "
                          "default the smallest of --radii, 0: none)")
-    ap.add_argument("--spacing-check-radius", type=float, default=0.0,
-                    help="radius of the marker-spacing check (method B, G = 0.2, kB_hat = 0.15, 5120 triangles; "
-                         "default 0: none)")
+    ap.add_argument("--fine-radii", default="",
+                    help="radii of the same study with 5120 triangles for the --fine-cases (default: none)")
+    ap.add_argument("--fine-cases", default="B:0.2",
+                    help="method:G of the 5120-triangle series, comma separated (kB_hat as the study pairs it; "
+                         "default B:0.2)")
     ap.add_argument("--jobs", type=int, default=1,
                     help="runs in parallel (default 1); run each with OMP_NUM_THREADS=1 when more than one")
     a = ap.parse_args()
@@ -400,9 +407,16 @@ def main():
         runs.append(LbmRun("A", 0.2, 0.15, check_radius, 1280, BOX, a.t_end, REYNOLDS / 2))
         wide = (BOX[0], BOX[1], CHECK_HEIGHT)
         runs.append(LbmRun("A", 0.2, 0.15, check_radius, 1280, wide, a.t_end, REYNOLDS * CHECK_HEIGHT / BOX[2]))
-    if a.spacing_check_radius > 0:
-        runs.append(LbmRun("B", 0.2, 0.15, a.spacing_check_radius, 5120, BOX, a.t_end))
-    bim_runs = sorted({BimRun(r.method, r.G, r.kappa_b, a.t_end) for r in runs}, key=lambda b: b.name)
+    fine_radii = [float(r) for r in a.fine_radii.split(",") if r.strip()]
+    for case in a.fine_cases.split(",") if fine_radii else []:
+        try:
+            m, g = case.split(":")
+            kb = 0.0 if m == "none" else dict(PAIRS)[float(g)]
+        except (ValueError, KeyError):
+            ap.error(f"--fine-cases: {case!r} is not METHOD:G with G one of {', '.join(fmt_g(g) for g, _ in PAIRS)}")
+        runs += [LbmRun(m, float(g), kb, R, FINE_TRIANGLES, BOX, a.t_end) for R in fine_radii]
+    bim_runs = sorted({BimRun(r.method, r.G, r.kappa_b, a.t_end, r.triangles if r.box == BOX else 1280)
+                       for r in runs}, key=lambda b: b.name)
 
     # Cost per step, one probe per distinct lattice (the fluid dominates; method A's forces stand in).
     probes = {}
@@ -464,8 +478,8 @@ def rel(path):
 
 
 def is_check(run):
-    """An inertia, confinement or marker-spacing check (not part of the resolution study)."""
-    return run.reynolds != REYNOLDS or run.box not in (BOX, FULL_BOX) or (run.box == BOX and run.triangles != 1280)
+    """An inertia or confinement check (not part of the resolution study)."""
+    return run.reynolds != REYNOLDS or run.box not in (BOX, FULL_BOX)
 
 
 def save_figure(fig, ax, xlabel, ylabel, title, png, alt, title_size=None):
@@ -535,23 +549,33 @@ def write_doc(a, runs, bim_runs, work, bim_work, cost, projected, totals):
           "(through three radii the curve passes through all three; with two, p = 1). Its 68 % range: the",
           "fit repeated with each D moved by its error (400 seeded normal draws). chi2: the weighted sum of",
           "squared residuals (1 degree of freedom per radius beyond three; about 1 each when the power law",
-          "holds). The check of the issue: D_inf within 3 % of the project's BIM at 1280 triangles. The",
-          "column p = 1 extrapolates the last two radii with the first-order convergence expected of the",
-          "immersed boundary (its kernel shifts the surface by a fraction of dx).", "",
-          "| G | kB_hat | method | " + " | ".join(f"D (R = {fmt_g(R)})" for R in radii_all)
-          + " | D_inf (p) | 68 % range | chi2 | smallest R within 2 % | BIM 1280 | D_inf / BIM - 1 | within 3 % | D_inf, p = 1 (vs BIM) |",
-          "|---|---|---|" + "---|" * (len(radii_all) + 8)]
-    cases = sorted({(r.G, r.kappa_b, r.method) for r in main_runs})
+          "holds). The check of the issue: D_inf within 3 % of the project's BIM at 1280 triangles; a row",
+          f"with {FINE_TRIANGLES} triangles (--fine-radii) is set beside the BIM at {FINE_TRIANGLES} triangles (RKC, tree quadrature)",
+          "and, in its last cell, at 1280. The column p = 1 extrapolates the last two radii with the",
+          "first-order convergence expected of the immersed boundary (its kernel shifts the surface by a",
+          "fraction of dx). The paper's size (R = 13.5, 5120 triangles, its own box) is shown in the 1280",
+          "rows but not fitted.", "",
+          "| G | kB_hat | method | triangles | " + " | ".join(f"D (R = {fmt_g(R)})" for R in radii_all)
+          + " | D_inf (p) | 68 % range | chi2 | smallest R within 2 % | BIM | D_inf / BIM - 1 | within 3 % | D_inf, p = 1 (vs BIM) |",
+          "|---|---|---|---|" + "---|" * (len(radii_all) + 8)]
+
+    def case_of(r):
+        """(G, kB_hat, method, triangles of the series): the paper's size joins the 1280 rows."""
+        return (r.G, r.kappa_b, r.method, r.triangles if r.box == BOX else 1280)
+
+    cases = sorted({case_of(r) for r in main_runs})
     figs, fits = [], {}
-    for (G, kb, m) in cases:
-        rs = sorted([r for r in main_runs if (r.G, r.kappa_b, r.method) == (G, kb, m) and r.triangles == 1280],
-                    key=lambda r: r.radius)
+    for case in cases:
+        G, kb, m, tri = case
+        members = sorted([r for r in main_runs if case_of(r) == case], key=lambda r: r.radius)
+        by_radius = {r.radius: r for r in members}
         cells, pts, sig = [], [], []
-        for r in sorted([r for r in main_runs if (r.G, r.kappa_b, r.method) == (G, kb, m)], key=lambda r: r.radius):
-            s = finished_summary(work / r.name, r)
+        for R in radii_all:
+            r = by_radius.get(R)
+            s = finished_summary(work / r.name, r) if r else None
             err = steady_uncertainty(work / r.name, r.t_end) if s else None
             cells.append(with_error(s["D_steady"], err) if s and s.get("D_steady") is not None else "-")
-            if s and s.get("D_steady") is not None and r in rs:
+            if s and s.get("D_steady") is not None and r.box == BOX:
                 pts.append((r.radius, s["D_steady"]))
                 sig.append(err)
         weights = sig if pts and all(e and e > 0 for e in sig) else None
@@ -564,9 +588,12 @@ def write_doc(a, runs, bim_runs, work, bim_work, cost, projected, totals):
         if fit:
             ok = [R for R, D in pts if abs(D - fit[0]) <= 0.02 * abs(fit[0])]
             within = fmt_g(min(ok)) if ok else "none"
-        b = BimRun(m, G, kb, a.t_end)
-        bs = finished_summary(bim_work / b.name, b)
-        bim_d = bs.get("D_steady") if bs else None
+
+        def bim_of(triangles):
+            b = BimRun(m, G, kb, a.t_end, triangles)
+            bs = finished_summary(bim_work / b.name, b)
+            return b, (bs.get("D_steady") if bs else None)
+        b, bim_d = bim_of(tri)
         bim = f"{bim_d:.4f}" if bim_d is not None else "not run"
         dev = check = "-"
         if fit and bim_d:
@@ -576,43 +603,49 @@ def write_doc(a, runs, bim_runs, work, bim_work, cost, projected, totals):
                 dev += f" ({100 * (spread[0] / bim_d - 1):+.1f} to {100 * (spread[1] / bim_d - 1):+.1f} %)"
             check = ("yes" if abs(rel_dev) <= 0.03 else "**no**") + (
                 "" if fit[3] else " (p = 1 assumed)" if len(pts) < 3 else " (no p > 0 fits: p = 1, least squares)")
-        fits[(G, kb, m)] = (pts, fit, bim_d)
+        coarse_bim = bim_of(1280)[1] if tri != 1280 else None
+        if fit and coarse_bim:
+            check += f"; vs BIM 1280 ({coarse_bim:.4f}): {100 * (fit[0] / coarse_bim - 1):+.1f} %"
+        fits[case] = (pts, fit, bim_d)
         first = "-"
         if len(pts) >= 2:
             (R1, D1), (R2, D2) = pts[-2], pts[-1]
             d_first = D2 - (D1 - D2) / (1 / R1 - 1 / R2) / R2
             first = f"{d_first:.4f}" + (f" ({100 * (d_first / bim_d - 1):+.1f} %)" if bim_d else "")
-        L.append(f"| {fmt_g(G)} | {fmt_g(kb)} | {m} | " + " | ".join(cells)
+        L.append(f"| {fmt_g(G)} | {fmt_g(kb)} | {m} | {tri} | " + " | ".join(cells)
                  + f" | {fit_cell} | {spread_cell} | {chi_cell} | {within} | {bim} | {dev} | {check} | {first} |")
         # figure: D(gamma t), LBM at each R beside the BIM
         fig, ax = plt.subplots(figsize=(5.5, 3.6))
         any_line = False
-        for r in sorted([r for r in main_runs if (r.G, r.kappa_b, r.method) == (G, kb, m)], key=lambda r: r.radius):
+        for r in members:
             ser = read_series(work / r.name)
             if ser is not None:
                 ax.plot(ser["gamma_t"], ser["D"], label=f"LBM R = {fmt_g(r.radius)}")
                 any_line = True
         ser = read_series(bim_work / b.name)
         if ser is not None:
-            ax.plot(ser["gamma_t"], ser["D"], "k--", label="BIM 1280")
+            ax.plot(ser["gamma_t"], ser["D"], "k--", label=f"BIM {tri}")
             any_line = True
         if any_line:
-            figs.append(save_figure(fig, ax, "gamma t", "D", f"G = {fmt_g(G)}, kB_hat = {fmt_g(kb)}, method {m}",
-                                    figdir / f"D_G{fmt_g(G)}_kb{fmt_g(kb)}_{m}.png",
-                                    f"D against gamma t, G = {fmt_g(G)}, kB_hat = {fmt_g(kb)}, method {m}"))
+            tag = "" if tri == 1280 else f"_{tri}"
+            title = f"G = {fmt_g(G)}, kB_hat = {fmt_g(kb)}, method {m}" + ("" if tri == 1280 else f", {tri} triangles")
+            figs.append(save_figure(fig, ax, "gamma t", "D", title,
+                                    figdir / f"D_G{fmt_g(G)}_kb{fmt_g(kb)}_{m}{tag}.png", f"D against gamma t, {title}"))
         plt.close(fig)
     # Convergence in R: D_steady against 1 / R with the fit and the BIM value, one plot per G.
     conv = []
     for G in sorted({c[0] for c in cases}):
         fig, ax = plt.subplots(figsize=(5.5, 3.6))
         drawn = False
-        for i, (g, kb, m) in enumerate(c for c in cases if c[0] == G):
-            pts, fit, bim_d = fits[(g, kb, m)]
+        for i, case in enumerate(c for c in cases if c[0] == G):
+            _, kb, m, tri = case
+            pts, fit, bim_d = fits[case]
             if not pts:
                 continue
             colour = f"C{i}"
             x = [1 / R for R, _ in pts]
-            ax.plot(x, [D for _, D in pts], "o", color=colour, label=f"{m}, kB_hat = {fmt_g(kb)}")
+            ax.plot(x, [D for _, D in pts], "o" if tri == 1280 else "D", color=colour,
+                    label=f"{m}, kB_hat = {fmt_g(kb)}" + ("" if tri == 1280 else f", {tri} triangles"))
             if fit:
                 xs = np.linspace(0, max(x), 50)
                 ax.plot(xs, fit[0] + fit[1] * np.power(np.maximum(xs, 1e-12), fit[2]), "-", color=colour, lw=0.8)
@@ -622,32 +655,29 @@ def write_doc(a, runs, bim_runs, work, bim_work, cost, projected, totals):
         if drawn:
             ax.set_xlim(left=-0.006)
             conv.append(save_figure(fig, ax, "1 / R (lattice units)", "steady D",
-                                    f"G = {fmt_g(G)}: LBM (dots), fit (lines), BIM 1280 (squares at 1/R = 0)",
+                                    f"G = {fmt_g(G)}: LBM (markers), fit (lines), BIM at as many triangles (squares at 1/R = 0)",
                                     figdir / f"convergence_G{fmt_g(G)}.png", f"steady D against 1 / R, G = {fmt_g(G)}",
-                                    title_size=9))
+                                    title_size=8))
         plt.close(fig)
     if conv:
         L += ["", "## Convergence in R", ""] + [c + "\n" for c in conv]
     # Checks
     checks = [r for r in runs if is_check(r)]
     if checks:
-        L += ["", "## Inertia, confinement and marker-spacing checks", "",
+        L += ["", "## Inertia and confinement checks", "",
               "At one radius, method A, G = 0.2, kB_hat = 0.15 (the largest deformation), beside the same run",
               f"in the study's setup (Re = {fmt_g(REYNOLDS)}, walls {fmt_g(BOX[2])} R apart): inertia, the spec's check, with",
               "the shear rate halved (Re and the particle Re halved); confinement, the walls",
               f"{fmt_g(CHECK_HEIGHT)} R apart at the same shear rate (Re scaled with the wall speed, particle Re",
-              "unchanged). The BIM's capsule is in unbounded shear. Marker spacing (where run): method B at",
-              "G = 0.2, kB_hat = 0.15 with 5120 triangles instead of 1280, the nodes' spacing halved (1280",
-              "triangles: edges of about 0.15 R, so above dx from R = 7).", "",
+              "unchanged). The BIM's capsule is in unbounded shear.", "",
               "| check | R | D (study setup) | D (check) | relative change |",
               "|---|---|---|---|---|"]
         for r in checks:
-            base = LbmRun(r.method, r.G, r.kappa_b, r.radius, 1280, BOX, r.t_end)
+            base = LbmRun(r.method, r.G, r.kappa_b, r.radius, r.triangles, BOX, r.t_end)
             s0, s1 = finished_summary(work / base.name, base), finished_summary(work / r.name, r)
             d0 = s0.get("D_steady") if s0 else None
             d1 = s1.get("D_steady") if s1 else None
-            what = (f"marker spacing: method {r.method}, {r.triangles} triangles" if r.triangles != 1280 else
-                    f"inertia: Re = {fmt_g(r.reynolds)}" if r.box == BOX else
+            what = (f"inertia: Re = {fmt_g(r.reynolds)}" if r.box == BOX else
                     f"confinement: walls {fmt_g(r.box[2])} R apart, Re = {fmt_g(r.reynolds)}")
             L.append(f"| {what} | {fmt_g(r.radius)} | " + (f"{d0:.4f}" if d0 is not None else "-") + " | "
                      + (f"{d1:.4f}" if d1 is not None else "-") + " | "
