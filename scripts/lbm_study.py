@@ -291,12 +291,12 @@ def read_series(folder):
     return {k: np.array([float(r[k]) for r in rows]) for k in ("gamma_t", "D")} if rows else None
 
 
-def steady_uncertainty(folder, t_end, blocks=5):
-    """Standard error of the steady D from its time series: the steady window (gamma t in [5, 10],
-    include/bendlab/capsule/steady_statistics.hpp) cut into `blocks` equal blocks, the standard
-    deviation of the block means over sqrt(blocks). None without a full window."""
+def steady_uncertainty(folder, window, blocks=5):
+    """Standard error of the steady D from its time series: the run's steady window (summary.json's
+    steady_window, [begin, end]) cut into `blocks` equal blocks, the standard deviation of the block
+    means over sqrt(blocks). None without a full window."""
     ser = read_series(folder)
-    lo, hi = (5.0, 10.0) if t_end >= 10 else (t_end / 2, t_end)
+    lo, hi = window
     if ser is None or ser["gamma_t"][-1] < hi - 1e-9:
         return None
     t, D = ser["gamma_t"], ser["D"]
@@ -573,7 +573,7 @@ def write_doc(a, runs, bim_runs, work, bim_work, cost, projected, totals):
         for R in radii_all:
             r = by_radius.get(R)
             s = finished_summary(work / r.name, r) if r else None
-            err = steady_uncertainty(work / r.name, r.t_end) if s else None
+            err = steady_uncertainty(work / r.name, s["steady_window"]) if s else None
             cells.append(with_error(s["D_steady"], err) if s and s.get("D_steady") is not None else "-")
             if s and s.get("D_steady") is not None and r.box == BOX:
                 pts.append((r.radius, s["D_steady"]))

@@ -85,8 +85,8 @@ def test_block_error_of_a_steady_mean(tmp_path):
             f.write(f"{ti:.6f},{di:.12f}\n")
     means = [c + e, c - e, c + e, c - e, c + e]
     expected = np.std(means, ddof=1) / math.sqrt(5)
-    got = lbm_study.steady_uncertainty(tmp_path, 10.0)
+    got = lbm_study.steady_uncertainty(tmp_path, (5.0, 10.0))
     assert got == pytest.approx(expected, rel=2e-3)
     with open(tmp_path / "timeseries.csv", "w") as f:  # a run stopped at gamma t = 8: no full window
         f.write("gamma_t,D\n" + "".join(f"{ti:.6f},{di:.12f}\n" for ti, di in zip(t, D) if ti <= 8.0))
-    assert lbm_study.steady_uncertainty(tmp_path, 10.0) is None
+    assert lbm_study.steady_uncertainty(tmp_path, (5.0, 10.0)) is None
