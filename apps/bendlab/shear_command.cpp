@@ -57,7 +57,7 @@ void shear(const ShearArgs& a) {
     throw Error("--integrator, --rtol, --atol and --bim-quadrature are for --solver bim: the lattice Boltzmann "
                 "solver takes fixed steps");
   if (a.solver == "bim" && a.given_lattice)
-    throw Error("--radius-lu, --box, --tau, --reynolds, --kernel and --sample-every are for --solver lbm");
+    throw Error("--radius-lu, --box, --tau, --reynolds, --kernel, --sample-every and --offset are for --solver lbm");
   ShearRunSpec spec;
   spec.lattice = a.lattice;
   spec.integrator = a.integrator;
@@ -170,6 +170,10 @@ const CommandRegistration registration([](CLI::App& app) {
   cmd->add_option("--sample-every", args->lattice.sample_every,
                   "gamma t between time-series rows, rounded to whole lattice steps (lbm)")
       ->capture_default_str()->each(lattice);
+  cmd->add_option("--offset", args->lattice.offset,
+                  "the capsule's starting centre in dx from the box centre (a cell corner), each component in "
+                  "[-1, 1]: moves the capsule against the lattice nodes; a z offset carries it along x (lbm)")
+      ->delimiter(',')->expected(3)->capture_default_str()->each(lattice);
   cmd->add_option("--snapshot-every", args->snapshot_every, "gamma t between .vtp snapshots and checkpoints")
       ->capture_default_str();
   cmd->add_flag("--resume", args->resume,

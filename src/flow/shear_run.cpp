@@ -62,6 +62,10 @@ CapsuleRunResult run_shear(const ShearRunSpec& a, const ShearRunCallbacks& callb
     require_positive("--radius-lu", a.lattice.radius_lu);
     require_positive("--sample-every", a.lattice.sample_every);
     if (a.lattice.box.size() != 3) throw Error("--box needs three multiples of R: x,y,z");
+    if (a.lattice.offset.size() != 3) throw Error("--offset needs three components in dx: x,y,z");
+    for (double o : a.lattice.offset)
+      if (!std::isfinite(o) || std::abs(o) > 1.0)
+        throw Error(fmt::format("--offset {}: each component must be within [-1, 1] dx", o));
     if (a.lattice.kernel != "phi2" && a.lattice.kernel != "phi3" && a.lattice.kernel != "phi4")
       throw Error(fmt::format("--kernel '{}': the kernels are phi2, phi3, phi4", a.lattice.kernel));
     // tau, Re, the box and the walls are checked by lbm::capsule_run_parameters below, before any work.
@@ -159,6 +163,7 @@ CapsuleRunResult run_shear(const ShearRunSpec& a, const ShearRunCallbacks& callb
     lo.lattice = p;
     lo.kernel = in.kernel;
     lo.sample_every = l.sample_every;
+    lo.offset = Vec3(l.offset[0], l.offset[1], l.offset[2]);
     // LbmCapsuleSolver's reporting interval (a parallel solver takes the same steps).
     const auto sample_steps = std::max<std::int64_t>(1, std::llround(l.sample_every / p.shear_rate));
     if (callbacks.make_lbm_solver) {
@@ -171,6 +176,8 @@ CapsuleRunResult run_shear(const ShearRunSpec& a, const ShearRunCallbacks& callb
     lattice_arguments = {{"radius_lu", l.radius_lu}, {"box", l.box},      {"tau", l.tau},
                          {"reynolds", l.reynolds},   {"kernel", l.kernel}, {"sample_every", l.sample_every},
                          {"kappa_v_over_kappa_s", kEspressoVolumeRatio}};
+    // Only when given, so that the runs made before the option existed still resume.
+    if (!lo.offset.isZero(0)) lattice_arguments["offset"] = l.offset;
     summary_fields = {{"lattice",
                        {{"nodes", {p.nx, p.ny, p.nz}},
                         {"nu", p.nu},

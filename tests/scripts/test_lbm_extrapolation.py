@@ -90,3 +90,31 @@ def test_block_error_of_a_steady_mean(tmp_path):
     with open(tmp_path / "timeseries.csv", "w") as f:  # a run stopped at gamma t = 8: no full window
         f.write("gamma_t,D\n" + "".join(f"{ti:.6f},{di:.12f}\n" for ti, di in zip(t, D) if ti <= 8.0))
     assert lbm_study.steady_uncertainty(tmp_path, (5.0, 10.0)) is None
+
+
+def test_placement_sigma_recovers_the_spread_of_one_placement():
+    # Each D = D_true + e with e ~ N(0, s), two placements per radius: the estimate is s.
+    rng = np.random.default_rng(7)
+    s = 3e-4
+    pairs = [(0.21 + rng.normal(0, s), 0.21 + rng.normal(0, s)) for _ in range(4000)]
+    assert lbm_study.placement_sigma(pairs) == pytest.approx(s, rel=0.05)
+    assert lbm_study.placement_sigma([(0.2, 0.2)]) == 0.0
+    assert lbm_study.placement_sigma([(0.2, 0.2 + 2e-4)]) == pytest.approx(2e-4 / math.sqrt(2), rel=1e-12)
+    assert lbm_study.placement_sigma([]) is None
+
+
+def test_placement_runs_are_named_and_started_apart_from_the_study():
+    centred = lbm_study.LbmRun("B", 0.2, 0.15, 8.0, 5120, lbm_study.BOX, 10.0)
+    moved = lbm_study.LbmRun("B", 0.2, 0.15, 8.0, 5120, lbm_study.BOX, 10.0, offset=0.5)
+    assert moved.name == centred.name + "_offset0.5"
+    args = moved.arguments("out")
+    assert args[args.index("--offset") + 1] == "0.5,0.5,0.5"
+    assert "--offset" not in centred.arguments("out")
+    assert lbm_study.is_placement(moved) and not lbm_study.is_placement(centred)
+    assert not lbm_study.is_check(moved)
+    # A finished run's summary is matched with its own placement only.
+    summary = {"solver": "lbm", "method": "B", "mesh": "mt1:5120", "G": 0.2, "kappa_b_hat": 0.15,
+               "radius_lu": 8.0, "reynolds": 0.2, "box": list(lbm_study.BOX)}
+    assert lbm_study.lbm_matches(summary, centred) and not lbm_study.lbm_matches(summary, moved)
+    summary["offset"] = [0.5, 0.5, 0.5]
+    assert lbm_study.lbm_matches(summary, moved) and not lbm_study.lbm_matches(summary, centred)

@@ -27,6 +27,9 @@ struct LatticeRunSpec {
   double reynolds = 0.2;               ///< Re = R v / nu of the wall speed (the paper's; warned above 0.3)
   std::string kernel = "phi2";         ///< immersed-boundary kernel: phi2, phi3, phi4
   double sample_every = 1e-3;          ///< gamma t between time-series rows
+  /// The capsule's starting centroid in dx from the box centre, each component in [-1, 1]
+  /// (LbmSolverOptions::offset); recorded in the run's arguments only when not zero.
+  std::vector<double> offset = {0, 0, 0};
 };
 
 struct ShearRunSpec {

@@ -17,6 +17,9 @@ const std::shared_ptr<const MembraneModel>& checked(const std::shared_ptr<const 
   if (!(o.radius > 0) || !std::isfinite(o.radius)) throw Error(fmt::format("LBM: radius {} must be positive", o.radius));
   if (!(o.sample_every > 0) || !std::isfinite(o.sample_every))
     throw Error(fmt::format("LBM: sample_every {} must be positive", o.sample_every));
+  if (!o.offset.allFinite() || o.offset.cwiseAbs().maxCoeff() > 1.0)
+    throw Error(fmt::format("LBM: offset ({}, {}, {}) must be within [-1, 1] dx in each component", o.offset[0],
+                            o.offset[1], o.offset[2]));
   if (!(o.lattice.shear_rate > 0) || !std::isfinite(o.lattice.shear_rate))
     throw Error("LBM: the lattice parameters have no shear rate (use lbm::capsule_run_parameters)");
   return m;
@@ -34,6 +37,8 @@ void IbCapsuleSolver::place_capsule(double shear_rate, double viscosity) {
   x_ = membrane_->reference_positions();
   x_.rowwise() -= volume_centroid(membrane_->topology(), x_).transpose();
   X_ = options_.radius * x_;
+  X_.rowwise() += options_.offset.transpose();
+  x_ = X_ / options_.radius;  // the run's positions are the lattice ones over R (as after every step)
   const lbm::LatticeConfig g = options_.lattice.lattice_config();
   for (Eigen::Index k = 0; k < X_.rows(); ++k) lbm::ib_stencil({g.nx, g.ny, g.nz}, g.walls, row(X_, k), options_.kernel);
 }

@@ -46,6 +46,11 @@ struct LbmSolverOptions {
   lbm::CapsuleRunParameters lattice;            ///< from lbm::capsule_run_parameters()
   lbm::IbKernel kernel = lbm::IbKernel::Phi2;
   double sample_every = 1e-3;                   ///< gamma t between reported steps (>= 1 lattice step)
+  /// The capsule's volume centroid at the start, in dx from the box centre (a cell corner of
+  /// the lattice: nodes sit at half-integer coordinates). Each component within [-1, 1]: it moves
+  /// the capsule against the lattice (a measure of the immersed boundary's dependence on where
+  /// the surface meets the nodes), not in the flow; a z offset carries it along x at gamma z.
+  Vec3 offset = Vec3::Zero();
 };
 
 class IbCapsuleSolver : public CapsuleSolver {
@@ -80,8 +85,8 @@ class IbCapsuleSolver : public CapsuleSolver {
   IbCapsuleSolver(std::shared_ptr<const MembraneModel> membrane, LbmSolverOptions options);
 
   /// For the derived constructor, once its fluid exists (before it starts the shear flow): the
-  /// membrane's reference shape with its volume centroid at the box centre, time 0. Throws if a
-  /// node's kernel reaches a wall.
+  /// membrane's reference shape with its volume centroid at the box centre plus options.offset,
+  /// time 0. Throws if an offset component is outside [-1, 1] or a node's kernel reaches a wall.
   void place_capsule(double shear_rate, double viscosity);
 
   /// The fluid's lattice step count.
