@@ -5,6 +5,7 @@ resolution study of shared/spec/LBM_IBM.md section 5.
     /usr/bin/python3 scripts/lbm_study.py [--radii 6,8,10] [--full] [--t-end T]
                                           [--measure-steps N] [--only-measure] [--no-runs] [--no-bim] [--jobs N]
                                           [--check-radius R] [--fine-radii R,...] [--fine-cases M:G,...]
+                                          [--offset-radii R,...] [--offset-cases M:G,...]
                                           [--bim-work DIR] [--work DIR] [--doc FILE] [--bendlab PATH]
 
 Cases: (G, kappa_b_hat) = (0.05, 0.0375) and (0.2, 0.15) with the paper's LBM methods A and B
@@ -21,7 +22,11 @@ the 68 % range of D_inf when each D moves by its error, the smallest R within 2 
 the same study with 5120 triangles for the cases of --fine-cases (default B:0.2, method B at
 G = 0.2): the spacing of the membrane's nodes halved (1280 triangles: edges of about 0.15 R, above
 dx from R = 7; 5120: below dx up to R = 13), against the BIM at 5120 triangles (scripts/
-shear_study.py part (e)'s run: RKC, tree quadrature) and at 1280. Two checks of the
+shear_study.py part (e)'s run: RKC, tree quadrature) and at 1280. --offset-radii R,... runs the
+5120-triangle cases of --offset-cases (default B:0.2) again at those radii with the capsule's centre
+moved by half a dx along x, y and z (`bendlab shear --offset`): the spread of D with where the
+surface meets the nodes, which the time blocks do not see, joins each D's error in the fit. A table
+reads the check of each case from its finest series. Two checks of the
 physics at one radius (--check-radius, default the smallest; 0 leaves them out), method A at
 G = 0.2, kappa_b_hat = 0.15 (the largest deformation): inertia, the spec's protocol, with the shear
 rate halved (Re = 0.1, particle Re 0.02), and confinement, the walls 16 R apart instead of 10 R with
