@@ -26,11 +26,14 @@ shear_study.py part (e)'s run: RKC, tree quadrature) and at 1280. --offset-radii
 5120-triangle cases of --offset-cases (default B:0.2) again at those radii with the capsule's centre
 moved by half a dx along x, y and z (`bendlab shear --offset`): the spread of D with where the
 surface meets the nodes, which the time blocks do not see, joins each D's error in the fit. A table
-reads the check of each case from its finest series. Two checks of the
+reads the check of each case from its finest series. Three checks of the
 physics at one radius (--check-radius, default the smallest; 0 leaves them out), method A at
 G = 0.2, kappa_b_hat = 0.15 (the largest deformation): inertia, the spec's protocol, with the shear
-rate halved (Re = 0.1, particle Re 0.02), and confinement, the walls 16 R apart instead of 10 R with
-the same shear rate (Re scaled by 1.6, particle Re unchanged; the BIM has no walls). The BIM values beside them are read from the BIM runs with the
+rate halved (Re = 0.1, particle Re 0.02); confinement, the walls 16 R apart instead of 10 R with
+the same shear rate (Re scaled by 1.6, particle Re unchanged; the BIM has no walls); and the
+kernel, phi4 (support 4 dx) instead of phi2 (2 dx): how far the immersed boundary's smearing of the
+surface moves D at that radius, the error the extrapolation in R removes (with 5120 triangles too
+when A:0.2 is a --fine-cases case and the check radius one of --fine-radii). The BIM values beside them are read from the BIM runs with the
 same G, kappa_b_hat, method and 1280 triangles in --bim-work (default studies/shear, the
 folder of scripts/shear_study.py); missing BIM runs are run there with scripts/shear_study.py's
 naming, so the two studies share them.
@@ -84,6 +87,8 @@ FINE_TRIANGLES = 5120  # the --fine-radii series: the nodes' spacing halved
 # 1 / R (its kernel shifts the surface by a fraction of dx), so such radii are not yet asymptotic.
 SLOW_P = 0.5
 PLACEMENT_OFFSET = 0.5  # --offset-radii: the capsule's centre moved by half a dx along x, y and z
+KERNEL = "phi2"  # the study's immersed-boundary kernel (ESPResSo's)
+CHECK_KERNEL = "phi4"  # the kernel check's: twice the support
 
 
 def fmt_g(x):
@@ -101,6 +106,7 @@ class LbmRun:
     t_end: float
     reynolds: float = REYNOLDS
     offset: float = 0.0  # the capsule's starting centre, in dx from the box centre, along x, y and z
+    kernel: str = KERNEL  # the immersed-boundary kernel (bendlab shear --kernel)
 
     @property
     def name(self):
@@ -108,13 +114,15 @@ class LbmRun:
                 f"_kb{fmt_g(self.kappa_b)}_t{fmt_g(self.t_end)}"
                 + ("" if self.reynolds == REYNOLDS else f"_Re{fmt_g(self.reynolds)}")
                 + ("" if self.box in (BOX, FULL_BOX) else f"_box{'x'.join(fmt_g(b) for b in self.box)}")
-                + ("" if self.offset == 0 else f"_offset{fmt_g(self.offset)}"))
+                + ("" if self.offset == 0 else f"_offset{fmt_g(self.offset)}")
+                + ("" if self.kernel == KERNEL else f"_{self.kernel}"))
 
     def label(self):
         return (f"LBM method {self.method:>4}, R = {fmt_g(self.radius):>4}, G = {fmt_g(self.G)}, kB_hat = {fmt_g(self.kappa_b)}"
                 + ("" if self.reynolds == REYNOLDS else f", Re = {fmt_g(self.reynolds)}")
                 + ("" if self.box in (BOX, FULL_BOX) else f", box {' x '.join(fmt_g(b) for b in self.box)} R")
-                + ("" if self.offset == 0 else f", centre offset {fmt_g(self.offset)} dx"))
+                + ("" if self.offset == 0 else f", centre offset {fmt_g(self.offset)} dx")
+                + ("" if self.kernel == KERNEL else f", {self.kernel} kernel"))
 
     def nodes(self):
         return [math.floor(b * self.radius + 0.5) for b in self.box]  # as the solver rounds (half up)
@@ -134,7 +142,8 @@ class LbmRun:
                 "--radius-lu", fmt_g(self.radius), "--box", ",".join(fmt_g(b) for b in self.box),
                 "--tau", fmt_g(TAU), "--reynolds", fmt_g(self.reynolds),
                 "--t-end", fmt_g(self.t_end if t_end is None else t_end), "--out", str(out), "--no-plot"] + (
-                    ["--offset", ",".join([fmt_g(self.offset)] * 3)] if self.offset else [])
+                    ["--offset", ",".join([fmt_g(self.offset)] * 3)] if self.offset else []) + (
+                    [] if self.kernel == KERNEL else ["--kernel", self.kernel])
 
 
 @dataclass(frozen=True)
@@ -187,6 +196,7 @@ def lbm_matches(args, run):
                 and close(args.get("kappa_b_hat"), run.kappa_b) and close(args.get("radius_lu"), run.radius)
                 and close(args.get("reynolds", REYNOLDS), run.reynolds)
                 and all(close(a, run.offset) for a in args.get("offset", [0.0, 0.0, 0.0]))
+                and args.get("kernel", KERNEL) == run.kernel
                 and all(close(a, b) for a, b in zip(args.get("box", []), run.box)))
     except (TypeError, ValueError, AttributeError):
         return False
@@ -427,6 +437,7 @@ def main():
         runs.append(LbmRun("A", 0.2, 0.15, check_radius, 1280, BOX, a.t_end, REYNOLDS / 2))
         wide = (BOX[0], BOX[1], CHECK_HEIGHT)
         runs.append(LbmRun("A", 0.2, 0.15, check_radius, 1280, wide, a.t_end, REYNOLDS * CHECK_HEIGHT / BOX[2]))
+        runs.append(LbmRun("A", 0.2, 0.15, check_radius, 1280, BOX, a.t_end, kernel=CHECK_KERNEL))
     def cases_of(option, text):
         out = []
         for case in text.split(","):
@@ -444,6 +455,9 @@ def main():
             # the inertia check with as many triangles: does the membrane's time step (kB dt / (mu h^3)
             # grows 8 times when h halves) make the difference between the meshes?
             runs.append(LbmRun("A", 0.2, 0.15, check_radius, FINE_TRIANGLES, BOX, a.t_end, REYNOLDS / 2))
+            # and the kernel check: is the difference between the meshes the smearing of phi2's
+            # narrow support over nodes closer than dx / 2?
+            runs.append(LbmRun("A", 0.2, 0.15, check_radius, FINE_TRIANGLES, BOX, a.t_end, kernel=CHECK_KERNEL))
     offset_radii = [float(r) for r in a.offset_radii.split(",") if r.strip()]
     for m, g, kb in cases_of("--offset-cases", a.offset_cases) if offset_radii else []:
         for R in offset_radii:
@@ -513,8 +527,8 @@ def rel(path):
 
 
 def is_check(run):
-    """An inertia or confinement check (not part of the resolution study)."""
-    return run.reynolds != REYNOLDS or run.box not in (BOX, FULL_BOX)
+    """An inertia, confinement or kernel check (not part of the resolution study)."""
+    return run.reynolds != REYNOLDS or run.box not in (BOX, FULL_BOX) or run.kernel != KERNEL
 
 
 def is_placement(run):
@@ -760,12 +774,15 @@ def write_doc(a, runs, bim_runs, work, bim_work, cost, projected, totals):
     # Checks
     checks = [r for r in runs if is_check(r)]
     if checks:
-        L += ["", "## Inertia and confinement checks", "",
+        L += ["", "## Inertia, confinement and kernel checks", "",
               "At one radius, method A, G = 0.2, kB_hat = 0.15 (the largest deformation), beside the same run",
-              f"in the study's setup (Re = {fmt_g(REYNOLDS)}, walls {fmt_g(BOX[2])} R apart): inertia, the spec's check, with",
+              f"in the study's setup (Re = {fmt_g(REYNOLDS)}, walls {fmt_g(BOX[2])} R apart, {KERNEL} kernel): inertia, the spec's check, with",
               "the shear rate halved (Re and the particle Re halved); confinement, the walls",
               f"{fmt_g(CHECK_HEIGHT)} R apart at the same shear rate (Re scaled with the wall speed, particle Re",
-              "unchanged). The BIM's capsule is in unbounded shear.", "",
+              f"unchanged); kernel, {CHECK_KERNEL} (support 4 dx) instead of {KERNEL} (2 dx), which smears the surface",
+              "over twice the width: a measure of the immersed boundary's own error at that radius, which the",
+              "extrapolation in R is there to remove (it is not expected to be small). The BIM's capsule is in",
+              "unbounded shear.", "",
               "| check | R | triangles | D (study setup) | D (check) | relative change |",
               "|---|---|---|---|---|---|"]
         for r in checks:
@@ -773,7 +790,8 @@ def write_doc(a, runs, bim_runs, work, bim_work, cost, projected, totals):
             s0, s1 = finished_summary(work / base.name, base), finished_summary(work / r.name, r)
             d0 = s0.get("D_steady") if s0 else None
             d1 = s1.get("D_steady") if s1 else None
-            what = (f"inertia: Re = {fmt_g(r.reynolds)}" if r.box == BOX else
+            what = (f"kernel: {r.kernel}" if r.kernel != KERNEL else
+                    f"inertia: Re = {fmt_g(r.reynolds)}" if r.box == BOX else
                     f"confinement: walls {fmt_g(r.box[2])} R apart, Re = {fmt_g(r.reynolds)}")
             L.append(f"| {what} | {fmt_g(r.radius)} | {r.triangles} | " + (f"{d0:.4f}" if d0 is not None else "-") + " | "
                      + (f"{d1:.4f}" if d1 is not None else "-") + " | "

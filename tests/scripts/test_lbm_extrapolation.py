@@ -118,3 +118,20 @@ def test_placement_runs_are_named_and_started_apart_from_the_study():
     assert lbm_study.lbm_matches(summary, centred) and not lbm_study.lbm_matches(summary, moved)
     summary["offset"] = [0.5, 0.5, 0.5]
     assert lbm_study.lbm_matches(summary, moved) and not lbm_study.lbm_matches(summary, centred)
+
+
+def test_kernel_check_runs_are_named_matched_and_kept_out_of_the_fit():
+    study = lbm_study.LbmRun("A", 0.2, 0.15, 6.0, 1280, lbm_study.BOX, 10.0)
+    wide = lbm_study.LbmRun("A", 0.2, 0.15, 6.0, 1280, lbm_study.BOX, 10.0, kernel="phi4")
+    assert wide.name == study.name + "_phi4"
+    args = wide.arguments("out")
+    assert args[args.index("--kernel") + 1] == "phi4"
+    assert "--kernel" not in study.arguments("out")
+    assert lbm_study.is_check(wide) and not lbm_study.is_check(study)
+    assert not lbm_study.is_placement(wide)
+    # A summary names its kernel; one without the field is the default kernel's (older runs).
+    summary = {"solver": "lbm", "method": "A", "mesh": "mt1:1280", "G": 0.2, "kappa_b_hat": 0.15,
+               "radius_lu": 6.0, "reynolds": 0.2, "box": list(lbm_study.BOX)}
+    assert lbm_study.lbm_matches(summary, study) and not lbm_study.lbm_matches(summary, wide)
+    summary["kernel"] = "phi4"
+    assert lbm_study.lbm_matches(summary, wide) and not lbm_study.lbm_matches(summary, study)
