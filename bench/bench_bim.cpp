@@ -114,6 +114,7 @@ void BM_SingleLayer(benchmark::State& state, SingleLayerQuadrature quadrature) {
 BENDLAB_SINGLE_LAYER(all7, SingleLayerQuadrature::all7);
 BENDLAB_SINGLE_LAYER(adaptive, SingleLayerQuadrature::adaptive);
 BENDLAB_SINGLE_LAYER(tree, SingleLayerQuadrature::tree);
+BENDLAB_SINGLE_LAYER(tree_mixed, SingleLayerQuadrature::tree_mixed);
 
 enum Shape { kRbc, kEllipsoid };
 
@@ -183,6 +184,8 @@ BENDLAB_RATIO(rbc, kRbc, SingleLayerQuadrature::adaptive);
 BENDLAB_RATIO(ellipsoid, kEllipsoid, SingleLayerQuadrature::adaptive);
 BENDLAB_RATIO(rbc_tree, kRbc, SingleLayerQuadrature::tree);
 BENDLAB_RATIO(ellipsoid_tree, kEllipsoid, SingleLayerQuadrature::tree);
+BENDLAB_RATIO(rbc_tree_mixed, kRbc, SingleLayerQuadrature::tree_mixed);
+BENDLAB_RATIO(ellipsoid_tree_mixed, kEllipsoid, SingleLayerQuadrature::tree_mixed);
 
 #define BENDLAB_TREE_SCAN(name, shape)                                                  \
   BENCHMARK_CAPTURE(BM_TreeParameters, name, shape)                                      \

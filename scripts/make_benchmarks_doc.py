@@ -348,7 +348,8 @@ def main():
         if ratios:
             w("`BM_QuadratureRatio`: both quadratures in every iteration of one run, on the red blood cell")
             w("(R = 1) and the 2:1:0.5 ellipsoid, force density = Method C's bending force density;")
-            w("speedup = time of all7 / time of the other rule (adaptive, or tree for the `_tree` shapes);")
+            w("speedup = time of all7 / time of the other rule (adaptive; tree for the `_tree` shapes, tree-mixed,")
+            w("the tree with single-precision sums, for `_tree_mixed`);")
             w("difference = max_i |u_other - u_all7| / max_i |u_all7| (each rule's defaults;")
             w("`stokes_single_layer.hpp` lists settings within 1e-5).")
             w("")
@@ -356,7 +357,7 @@ def main():
             w("| --- | --- | --- | --- | --- | --- | --- | --- |")
             for r in ratios:
                 b, a_ = r["b"], r["args"]
-                other = "tree" if "s_tree" in b else "adaptive"
+                other = next((q for q in ("tree-mixed", "tree") if "s_" + q in b), "adaptive")
                 w(f"| {r['variant']} | {a_.get('triangles')} | {a_.get('threads')} | {other} | {ratio_cells(b, other)} |")
             w("")
         scan = [r for r in bim["rows"] if r["family"] == "BM_TreeParameters" and not r["error"]]

@@ -999,9 +999,10 @@ def main():
     ap.add_argument("--triangles-a", type=int, default=1280, help="resolution of part (a) (default 1280)")
     ap.add_argument("--triangles-e", type=int, default=5120,
                     help="resolution of part (e) (default 5120, the paper's; smaller for a quick preview)")
-    ap.add_argument("--bim-quadrature-e", choices=["all7", "tree"], default="all7",
-                    help="BIM quadrature of part (e)'s runs: all7 (default, the reference) or tree (within "
-                         "1e-5 of it, faster at 5120 triangles; its runs are cached under names ending in _tree)")
+    ap.add_argument("--bim-quadrature-e", choices=["all7", "tree", "tree-mixed"], default="all7",
+                    help="BIM quadrature of part (e)'s runs: all7 (default, the reference), tree (within "
+                         "1e-5 of it, faster at 5120 triangles; its runs are cached under names ending in _tree) "
+                         "or tree-mixed (the tree with single-precision sums; names ending in _tree-mixed)")
     ap.add_argument("--list", action="store_true",
                     help="print the runs the chosen parts need, with their command lines and whether each "
                          "is done, can resume from a checkpoint or is still to run; runs nothing")

@@ -97,7 +97,7 @@ void bind_capsule(py::module_& m) {
       "with C = skalak_c; plus the bending method) in "
       "the shear flow u = gamma z e_x with the boundary integral method (eqs. 22-23), units R = mu = gamma "
       "= 1 (kS = 1/G, kB = kappa_b_hat / G), advanced by `integrator` ('cash-karp' or 'rkc'), the single layer's regular quadrature "
-      "`bim_quadrature` (the reference 'all7', 'adaptive' or 'tree'), until gamma t = t_end, keeping the run folder (timeseries.csv, "
+      "`bim_quadrature` (the reference 'all7', 'adaptive', 'tree' or 'tree-mixed'), until gamma t = t_end, keeping the run folder (timeseries.csv, "
       "snapshots, checkpoint.json, summary.json) exactly as `bendlab shear` does. progress(dict) is called "
       "every progress_interval seconds. Returns summary.json's content, or None when stopped by "
       "stop_after_steps. Ctrl-C (or an exception in progress) stops the run at the next step and is raised; "

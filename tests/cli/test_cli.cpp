@@ -420,6 +420,9 @@ TEST_F(Cli, ShearBimQuadratureIsRecordedAndPartOfTheIdentity) {
   const fs::path tree = dir / "tree";
   ASSERT_EQ(run("shear --bim-quadrature tree" + common + tree.string()).status, 0);
   EXPECT_EQ(nlohmann::json::parse(slurp(tree / "summary.json"))["bim_quadrature"], "tree");
+  const fs::path mixed = dir / "tree-mixed";
+  ASSERT_EQ(run("shear --bim-quadrature tree-mixed" + common + mixed.string()).status, 0);
+  EXPECT_EQ(nlohmann::json::parse(slurp(mixed / "summary.json"))["bim_quadrature"], "tree-mixed");
   expect_refused(run("shear --bim-quadrature fast" + common + (dir / "f").string()), "bim-quadrature", dir / "f");
   expect_refused(run("shear --solver lbm --bim-quadrature adaptive" + common + (dir / "l").string()),
                  "--bim-quadrature", dir / "l");

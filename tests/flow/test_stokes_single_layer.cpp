@@ -253,9 +253,10 @@ std::string scientific(double v) {
 }
 
 SingleLayerOptions tree_rule(double tolerance = SingleLayerOptions{}.tree_tolerance,
-                             double ratio = SingleLayerOptions{}.tree_ratio) {
+                             double ratio = SingleLayerOptions{}.tree_ratio,
+                             SingleLayerQuadrature quadrature = SingleLayerQuadrature::tree) {
   SingleLayerOptions o;
-  o.quadrature = SingleLayerQuadrature::tree;
+  o.quadrature = quadrature;
   o.tree_tolerance = tolerance;
   o.tree_ratio = ratio;
   return o;
@@ -263,10 +264,11 @@ SingleLayerOptions tree_rule(double tolerance = SingleLayerOptions{}.tree_tolera
 
 // max_i |u_tree - u_all7| / max_i |u_all7| on both shapes below the spec's 1e-5, and the far
 // field used (the difference is not at rounding level).
-void expect_tree_within_1e5(int triangles) {
+void expect_tree_within_1e5(int triangles, SingleLayerQuadrature quadrature = SingleLayerQuadrature::tree) {
+  const SingleLayerOptions rule = tree_rule(SingleLayerOptions{}.tree_tolerance, SingleLayerOptions{}.tree_ratio, quadrature);
   for (bool rbc : {true, false}) {
     const Case c = quadrature_case(triangles, rbc);
-    const double e = relative_difference(single_layer(c, tree_rule()), single_layer(c, with(SingleLayerQuadrature::all7)));
+    const double e = relative_difference(single_layer(c, rule), single_layer(c, with(SingleLayerQuadrature::all7)));
     ::testing::Test::RecordProperty(rbc ? "rbc" : "ellipsoid", scientific(e));
     const std::string what = std::string(rbc ? "red blood cell" : "ellipsoid 2:1:0.5") + ", " +
                              std::to_string(triangles) + " triangles";
@@ -339,5 +341,62 @@ TEST(StokesSingleLayer, TreeWithin1e5OfAll7At5120) {
   GTEST_SKIP() << "5120 triangles: too slow under the sanitizers (1280 runs there)";
 #else
   expect_tree_within_1e5(5120);
+#endif
+}
+
+// tree-mixed: the tree's terms with its sums in single precision (stokes_single_layer.hpp).
+TEST(StokesSingleLayer, TreeMixedNames) {
+  EXPECT_EQ(single_layer_quadrature("tree-mixed"), SingleLayerQuadrature::tree_mixed);
+  EXPECT_EQ(to_string(SingleLayerQuadrature::tree_mixed), "tree-mixed");
+  EXPECT_THROW(single_layer_quadrature("tree_mixed"), Error);
+}
+
+namespace {
+// max_i |u_mixed - u_tree| / max_i |u_tree| on both shapes: the rounding of single precision
+// alone (the same clusters, proxies and terms), below `bound` and not zero.
+void expect_mixed_near_tree(int triangles, double bound) {
+  const SingleLayerOptions defaults;
+  for (bool rbc : {true, false}) {
+    const Case c = quadrature_case(triangles, rbc);
+    const double e = relative_difference(
+        single_layer(c, tree_rule(defaults.tree_tolerance, defaults.tree_ratio, SingleLayerQuadrature::tree_mixed)),
+        single_layer(c, tree_rule()));
+    ::testing::Test::RecordProperty(rbc ? "rbc" : "ellipsoid", scientific(e));
+    const std::string what = std::string(rbc ? "red blood cell" : "ellipsoid 2:1:0.5") + ", " +
+                             std::to_string(triangles) + " triangles";
+    EXPECT_LT(e, bound) << what;
+    EXPECT_GT(e, 1e-12) << what << ": the single-precision sums were not used";
+  }
+}
+}  // namespace
+
+TEST(StokesSingleLayer, TreeMixedWithinSinglePrecisionOfTreeAt1280) { expect_mixed_near_tree(1280, 1e-6); }
+
+TEST(StokesSingleLayer, TreeMixedWithoutFarFieldNearAll7) {
+  // Every face near: the 7-point rule over every face in single precision, against all7 in double.
+  const Case c = quadrature_case(1280, true);
+  const double e = relative_difference(single_layer(c, tree_rule(0.0, 1e100, SingleLayerQuadrature::tree_mixed)),
+                                       single_layer(c, with(SingleLayerQuadrature::all7)));
+  ::testing::Test::RecordProperty("difference", scientific(e));
+  EXPECT_LT(e, 1e-6);
+  EXPECT_GT(e, 1e-12);
+}
+
+TEST(StokesSingleLayer, TreeMixedZeroForceGivesZeroVelocity) {
+  Case c = quadrature_case(1280, false);
+  c.f.setZero();
+  const Points u = single_layer(c, tree_rule(SingleLayerOptions{}.tree_tolerance, SingleLayerOptions{}.tree_ratio,
+                                             SingleLayerQuadrature::tree_mixed));
+  EXPECT_EQ(u.cwiseAbs().maxCoeff(), 0.0);
+}
+
+TEST(StokesSingleLayer, TreeMixedWithin1e5OfAll7At1280) { expect_tree_within_1e5(1280, SingleLayerQuadrature::tree_mixed); }
+
+TEST(StokesSingleLayer, TreeMixedAt5120) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "5120 triangles: too slow under the sanitizers (1280 runs there)";
+#else
+  expect_mixed_near_tree(5120, 1e-6);
+  expect_tree_within_1e5(5120, SingleLayerQuadrature::tree_mixed);
 #endif
 }

@@ -47,7 +47,7 @@ struct ShearRunSpec {
   double t_end = 10;                   ///< gamma t
   double snapshot_every = 0.5;         ///< gamma t between snapshots and checkpoints
   std::string integrator = "cash-karp";  ///< BIM time stepping: "cash-karp" or "rkc" (stiff-stable, integrate/rkc.hpp)
-  std::string bim_quadrature = "all7";  ///< the BIM single layer's regular quadrature: "all7" (reference) or "adaptive" (stokes_single_layer.hpp)
+  std::string bim_quadrature = "all7";  ///< the BIM single layer's regular quadrature: "all7" (reference), "adaptive", "tree" or "tree-mixed" (stokes_single_layer.hpp)
   double rtol = 1e-7, atol = 1e-6;     ///< the BIM integrator's tolerances (atol in units of R)
   bool resume = false;                 ///< continue from folder/checkpoint.json
   std::int64_t stop_after_steps = 0;   ///< stop (resumable) after this many steps; 0: never

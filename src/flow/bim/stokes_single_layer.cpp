@@ -1,5 +1,7 @@
 #include "bendlab/flow/bim/stokes_single_layer.hpp"
 
+#include "bendlab/flow/bim/chebyshev_moments.hpp"
+
 #include <fmt/format.h>
 
 #include <Eigen/Eigenvalues>
@@ -72,6 +74,7 @@ std::string to_string(SingleLayerQuadrature q) {
     case SingleLayerQuadrature::all7: return "all7";
     case SingleLayerQuadrature::adaptive: return "adaptive";
     case SingleLayerQuadrature::tree: return "tree";
+    case SingleLayerQuadrature::tree_mixed: return "tree-mixed";
   }
   return "unknown";
 }
@@ -80,7 +83,8 @@ SingleLayerQuadrature single_layer_quadrature(const std::string& name) {
   if (name == "all7") return SingleLayerQuadrature::all7;
   if (name == "adaptive") return SingleLayerQuadrature::adaptive;
   if (name == "tree") return SingleLayerQuadrature::tree;
-  throw Error(fmt::format("single layer: unknown quadrature '{}' (all7, adaptive, tree)", name));
+  if (name == "tree-mixed") return SingleLayerQuadrature::tree_mixed;
+  throw Error(fmt::format("single layer: unknown quadrature '{}' (all7, adaptive, tree, tree-mixed)", name));
 }
 
 StokesSingleLayer::StokesSingleLayer(TopologyPtr topology, SingleLayerOptions options)
@@ -114,7 +118,7 @@ StokesSingleLayer::StokesSingleLayer(TopologyPtr topology, SingleLayerOptions op
     const int nc = (nf + options_.cluster_size - 1) / options_.cluster_size;
     for (auto* v : {&cx_, &cy_, &cz_, &far2_}) v->assign(nc, 0.0);
   }
-  if (options_.quadrature == SingleLayerQuadrature::tree && nf > 0) {
+  if (tree() && nf > 0) {
     keys_.resize(nf);
     // Halve the sorted range until a cluster holds at most tree_leaf_size faces, breadth first.
     std::vector<int> depth{0};
@@ -147,6 +151,11 @@ StokesSingleLayer::StokesSingleLayer(TopologyPtr topology, SingleLayerOptions op
     for (auto* v : {&bcx_, &bcy_, &bcz_, &tree_far2_}) v->assign(nn, 0.0);
     for (auto* v : {&tpx_, &tpy_, &tpz_, &tfx_, &tfy_, &tfz_})
       v->assign(static_cast<std::size_t>(proxies) * padded, 0.0);
+    if (options_.quadrature == SingleLayerQuadrature::tree_mixed) {
+      for (auto* v : {&sqx_, &sqy_, &sqz_, &sfx_, &sfy_, &sfz_}) v->assign(nq, 0.0f);
+      for (auto* v : {&spx_, &spy_, &spz_, &spfx_, &spfy_, &spfz_})
+        v->assign(static_cast<std::size_t>(proxies) * padded, 0.0f);
+    }
     // The basis T_a(s_x) T_b(s_y) T_c(s_z), a + b + c <= q, and the reference points in
     // [-1, 1]^3: approximate Fekete points, the first nm columns that column-pivoted QR picks
     // from the basis evaluated on the tensor grid of q + 3 Chebyshev nodes per axis.
@@ -217,22 +226,23 @@ Vec3 polar_integral(const Vec3& x0, const Vec3& x1, const Vec3& x2, const Vec3& 
   return sum;
 }
 
-// Sum over all quadrature points y_k of the Stokeslet G(y_k, x) . f_k w_k for one target x.
-// Compiled three times (AVX-512, AVX2+FMA and baseline x86-64) and picked at run time, so the
-// same binary runs everywhere and uses 8- or 4-wide doubles where the processor has them. The
-// file is built with -fno-math-errno (so that sqrt vectorises) and -ffp-contract=fast (FMA).
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
-__attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
-#endif
-void regular_sum(double xi, double yi, double zi, const double* __restrict qx, const double* __restrict qy,
-                 const double* __restrict qz, const double* __restrict fx, const double* __restrict fy,
-                 const double* __restrict fz, int nq, double* out) {
-  double ux = 0, uy = 0, uz = 0;
+// Sum over all quadrature points y_k of the Stokeslet G(y_k, x) . f_k w_k for one target x, in
+// the precision Real (double; float for tree_mixed, see the header). Inlined into the two
+// functions below, each compiled three times (AVX-512, AVX2+FMA and baseline x86-64) and picked at
+// run time, so the same binary runs everywhere and uses 8- or 4-wide doubles (16 or 8 floats)
+// where the processor has them. The file is built with -fno-math-errno (so that sqrt vectorises)
+// and -ffp-contract=fast (FMA).
+template <typename Real>
+[[gnu::always_inline]] inline void regular_sum_body(Real xi, Real yi, Real zi, const Real* __restrict qx,
+                                                    const Real* __restrict qy, const Real* __restrict qz,
+                                                    const Real* __restrict fx, const Real* __restrict fy,
+                                                    const Real* __restrict fz, int nq, double* out) {
+  Real ux = 0, uy = 0, uz = 0;
 #pragma omp simd reduction(+ : ux, uy, uz)
   for (int k = 0; k < nq; ++k) {
-    const double dx = qx[k] - xi, dy = qy[k] - yi, dz = qz[k] - zi;
-    const double s = 1.0 / std::sqrt(dx * dx + dy * dy + dz * dz);
-    const double fr = (fx[k] * dx + fy[k] * dy + fz[k] * dz) * s * s * s;
+    const Real dx = qx[k] - xi, dy = qy[k] - yi, dz = qz[k] - zi;
+    const Real s = Real(1) / std::sqrt(dx * dx + dy * dy + dz * dz);
+    const Real fr = (fx[k] * dx + fy[k] * dy + fz[k] * dz) * s * s * s;
     ux += fx[k] * s + dx * fr;
     uy += fy[k] * s + dy * fr;
     uz += fz[k] * s + dz * fr;
@@ -242,38 +252,24 @@ void regular_sum(double xi, double yi, double zi, const double* __restrict qx, c
   out[2] = uz;
 }
 
-// Chebyshev moments M_beta += sum_k T_beta(s_k) F_k, s_k = S (y_k - centre) (S column-major 3 x 3),
-// beta = (a, b, c), a + b + c <= q, in the order of tree_basis_ (a, then b, then c ascending).
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
 __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
 #endif
-void chebyshev_moments(const double* S, const double* centre, int q, const double* sx, const double* sy,
-                       const double* sz, const double* sfx, const double* sfy, const double* sfz, int count,
-                       double* __restrict mx, double* __restrict my, double* __restrict mz) {
-  double T[3][9];
-  for (int k = 0; k < count; ++k) {
-    const double r[3] = {sx[k] - centre[0], sy[k] - centre[1], sz[k] - centre[2]};
-    for (int d = 0; d < 3; ++d) {
-      const double s = S[d] * r[0] + S[3 + d] * r[1] + S[6 + d] * r[2];
-      T[d][0] = 1;
-      T[d][1] = s;
-      for (int a = 2; a <= q; ++a) T[d][a] = 2 * s * T[d][a - 1] - T[d][a - 2];
-    }
-    const double gx = sfx[k], gy = sfy[k], gz = sfz[k];
-    for (int a = 0, m = 0; a <= q; ++a)
-      for (int b = 0; a + b <= q; ++b) {
-        const double tab = T[0][a] * T[1][b];
-        const int nc = q - a - b + 1;
-#pragma omp simd
-        for (int c = 0; c < nc; ++c) {
-          const double t = tab * T[2][c];
-          mx[m + c] += t * gx;
-          my[m + c] += t * gy;
-          mz[m + c] += t * gz;
-        }
-        m += nc;
-      }
-  }
+void regular_sum(double xi, double yi, double zi, const double* __restrict qx, const double* __restrict qy,
+                 const double* __restrict qz, const double* __restrict fx, const double* __restrict fy,
+                 const double* __restrict fz, int nq, double* out) {
+  regular_sum_body(xi, yi, zi, qx, qy, qz, fx, fy, fz, nq, out);
+}
+
+// tree_mixed: the points relative to a box centre and the target's offset (xi, yi, zi) from the
+// same centre; eight (AVX2) partial sums per vector register in float, returned in double.
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
+__attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
+#endif
+void regular_sum_single(float xi, float yi, float zi, const float* __restrict qx, const float* __restrict qy,
+                        const float* __restrict qz, const float* __restrict fx, const float* __restrict fy,
+                        const float* __restrict fz, int nq, double* out) {
+  regular_sum_body(xi, yi, zi, qx, qy, qz, fx, fy, fz, nq, out);
 }
 
 // Proxy weights W_m = sum_beta C(beta, m) M_beta for m < nm (C row-major nm x nm), zero up to padded.
@@ -330,7 +326,7 @@ void StokesSingleLayer::prepare(const Points& x, const Points& f) const {
   const Faces& F = t.faces();
   const TriangleRule7& rule = triangle_rule7();
   const bool adaptive = options_.quadrature == SingleLayerQuadrature::adaptive;
-  const bool tree = options_.quadrature == SingleLayerQuadrature::tree;
+  const bool tree = this->tree();
   if ((adaptive || tree) && nf > 0) {
     // Sort the faces by the Morton key of their centroids (21 bits per axis over the bounding box).
     const Vec3 lo = x.colwise().minCoeff().transpose(), hi = x.colwise().maxCoeff().transpose();
@@ -395,6 +391,7 @@ void StokesSingleLayer::prepare(const Points& x, const Points& f) const {
     }
   }
   if (tree && nf > 0) prepare_tree(x);
+  if (tree && nf > 0 && options_.quadrature == SingleLayerQuadrature::tree_mixed) prepare_single_precision();
   if (!adaptive) return;
 
   // Clusters: centre, radius, and the far rule's moment-corrected weights.
@@ -574,6 +571,30 @@ void StokesSingleLayer::prepare_tree(const Points& x) const {
   for (int j = tree_level_[split] - 1; j >= 0; --j) process(j);
 }
 
+void StokesSingleLayer::prepare_single_precision() const {
+  const int nn = static_cast<int>(tree_begin_.size());
+#pragma omp parallel for schedule(static)
+  for (int j = 0; j < nn; ++j) {
+    const double c[3] = {bcx_[j], bcy_[j], bcz_[j]};
+    auto convert = [&](const std::vector<double>* from[6], std::vector<float>* to[6], std::size_t b, std::size_t e) {
+      for (int a = 0; a < 6; ++a)
+        for (std::size_t k = b; k < e; ++k)
+          (*to[a])[k] = static_cast<float>(a < 3 ? (*from[a])[k] - c[a] : (*from[a])[k]);
+    };
+    if (tree_child_[j] < 0) {
+      const std::vector<double>* from[6] = {&qx_, &qy_, &qz_, &fx_, &fy_, &fz_};
+      std::vector<float>* to[6] = {&sqx_, &sqy_, &sqz_, &sfx_, &sfy_, &sfz_};
+      convert(from, to, 7 * static_cast<std::size_t>(tree_begin_[j]), 7 * static_cast<std::size_t>(tree_end_[j]));
+    }
+    if (tree_count_[j] > 0) {
+      const std::vector<double>* from[6] = {&tpx_, &tpy_, &tpz_, &tfx_, &tfy_, &tfz_};
+      std::vector<float>* to[6] = {&spx_, &spy_, &spz_, &spfx_, &spfy_, &spfz_};
+      const std::size_t o = static_cast<std::size_t>(tree_proxy_[j]) * tree_count_[j];
+      convert(from, to, o, o + tree_count_[j]);
+    }
+  }
+}
+
 void StokesSingleLayer::velocity(const Points& x, const Points& f, double mu, Points& u) const {
   const Topology& t = *topology_;
   const int nv = t.num_vertices(), nf = t.num_faces();
@@ -584,7 +605,8 @@ void StokesSingleLayer::velocity(const Points& x, const Points& f, double mu, Po
   prepare(x, f);
 
   const bool adaptive = options_.quadrature == SingleLayerQuadrature::adaptive;
-  const bool tree = options_.quadrature == SingleLayerQuadrature::tree && nf > 0;
+  const bool tree = this->tree() && nf > 0;
+  const bool single = tree && options_.quadrature == SingleLayerQuadrature::tree_mixed;
   const int nq = 7 * nf;
   const double* qx = qx_.data(); const double* qy = qy_.data(); const double* qz = qz_.data();
   const double* fx = fx_.data(); const double* fy = fy_.data(); const double* fz = fz_.data();
@@ -600,7 +622,32 @@ void StokesSingleLayer::velocity(const Points& x, const Points& f, double mu, Po
     const double xi = x(i, 0), yi = x(i, 1), zi = x(i, 2);
     // The regular rule over every triangle (the hot loop).
     double ux = 0, uy = 0, uz = 0, acc[3];
-    if (tree) {
+    if (single) {
+      // As the tree below, each leaf and each far cluster summed on its own, in single precision
+      // relative to its box centre (a far cluster without proxies by its leaves).
+      int stack[128], top = 0;
+      stack[top++] = 0;
+      while (top > 0) {
+        const int j = stack[--top];
+        const double dx = bcx_[j] - xi, dy = bcy_[j] - yi, dz = bcz_[j] - zi;
+        const bool far = dx * dx + dy * dy + dz * dz >= tree_far2_[j];
+        const auto ox = static_cast<float>(-dx), oy = static_cast<float>(-dy), oz = static_cast<float>(-dz);
+        if (far && tree_count_[j] > 0) {
+          const std::size_t o = static_cast<std::size_t>(tree_proxy_[j]) * tree_count_[j];
+          regular_sum_single(ox, oy, oz, spx_.data() + o, spy_.data() + o, spz_.data() + o, spfx_.data() + o,
+                             spfy_.data() + o, spfz_.data() + o, tree_count_[j], acc);
+          ux += acc[0], uy += acc[1], uz += acc[2];
+        } else if (tree_child_[j] < 0) {
+          const std::size_t o = 7 * static_cast<std::size_t>(tree_begin_[j]);
+          regular_sum_single(ox, oy, oz, sqx_.data() + o, sqy_.data() + o, sqz_.data() + o, sfx_.data() + o,
+                             sfy_.data() + o, sfz_.data() + o, 7 * (tree_end_[j] - tree_begin_[j]), acc);
+          ux += acc[0], uy += acc[1], uz += acc[2];
+        } else {
+          stack[top++] = tree_child_[j] + 1;
+          stack[top++] = tree_child_[j];
+        }
+      }
+    } else if (tree) {
       // Top down from the root: a far cluster by its proxies (or its 7-point points where it has
       // none), a near one by its children, a near leaf by its 7-point points. Faces taken
       // directly come in sorted order; consecutive ranges are summed in one call.

@@ -78,8 +78,34 @@
 //   1e-13) instead of the square root and division was slower there (an experiment, not kept),
 //   all7 164 ms against 142 ms:
 //   the kernel trades the divider's throughput for the multiply-add ports, which are then full.
-//   Not tried: single-precision proxy sums, target clusters sharing one traversal, a cheaper rule
-//   for near triangles a few edge lengths away (the 7-point sums are now over half the work).
+//   Not tried: target clusters sharing one traversal, a cheaper rule for near triangles a few edge
+//   lengths away (the 7-point sums are now over half the work).
+//   (tree_mixed, "tree-mixed") the same tree and the same terms, with the regular sums (the near
+//   leaves' 7-point points and the far clusters' proxies) in single precision: eight lanes of
+//   AVX2 instead of four, and the single-precision square root and division, which have more
+//   than twice the throughput of the double ones that bound the double kernel. What makes it
+//   accurate: each leaf's points and each cluster's proxies are kept relative to their box
+//   centre (|y - c_j| <= rho_j), and the target's offset from that centre is formed in double
+//   before it is rounded, so every difference y_k - x_i carries an absolute error of about
+//   2^-24 rho_j (about 1e-6 relative for the nearest points of a 5120-triangle capsule, far less
+//   for the rest); each call sums one leaf or one cluster (at most a few hundred terms, eight
+//   partial sums in float), and the calls are summed in double. The ring triangles' 7-point
+//   terms, which the polar rule replaces, are taken back in double: their single-precision
+//   values differ by that relative error. Measured in the tests (tests/flow/
+//   test_stokes_single_layer.cpp), max_i |u - u_ref| / max_i |u_ref|: 2.4e-7 (red blood cell) and
+//   1.6e-7 (ellipsoid) from the double tree at 1280 triangles, 2.2e-7 from all7 with no far field
+//   (every face by the 7-point rule in single precision); from all7 with the defaults 1.2e-6 /
+//   3.6e-7 at 1280 and 2.2e-6 / 4.6e-7 at 5120 triangles (the tree's own 1.2e-6 / 2.8e-7 and
+//   2.2e-6 / 4.4e-7).
+//   Speed-up over all7 (bench_bim --benchmark_filter='BM_QuadratureRatio/.*_tree(_mixed)?/
+//   triangles:(1280|5120)/threads:1' --benchmark_min_time=2; AMD EPYC with AVX2, one thread, the
+//   background runs stopped; the moments by the vector kernel of chebyshev_moments.hpp in both):
+//   at 5120 triangles tree-mixed 2.16 (red blood cell) / 2.35 (ellipsoid), tree 1.53 / 1.75; at
+//   1280 tree-mixed 1.03 / 1.10, tree 0.83 / 0.88. Before the moments kernel (same run otherwise):
+//   tree-mixed 1.80 / 2.00, tree 1.42 / 1.57. perf of one tree-mixed evaluation at 5120: the sums
+//   52 %, the traversal, the ring correction and the polar integrals (velocity()) 22 % and their
+//   sines and cosines 4 %, the moments 8 %, the boxes 5 %. So the 3x over all7 at 5120 is not
+//   reached here either.
 // - Triangles that contain x_i: polar coordinates (rho, phi) centred on x_i [118]. There
 //   G dS = (I + e e^T) / rho * rho drho dphi, the singularity cancels, and with f linear along
 //   each ray the radial integral is exact: int_0^rho_max f drho = rho_max (f(x_i) + f_edge(phi)) / 2.
@@ -98,8 +124,9 @@ namespace bendlab {
 
 /// all7: the 7-point rule on every non-singular triangle for every target (the reference, default);
 /// adaptive: the 7-point rule near the target, the moment-corrected centroid rule far from it;
-/// tree: the 7-point rule near the target, Chebyshev proxies of a cluster tree far from it.
-enum class SingleLayerQuadrature { all7, adaptive, tree };
+/// tree: the 7-point rule near the target, Chebyshev proxies of a cluster tree far from it;
+/// tree_mixed: the tree with its regular sums in single precision (summed in double).
+enum class SingleLayerQuadrature { all7, adaptive, tree, tree_mixed };
 
 struct SingleLayerOptions {
   int angular_points = 8;        ///< Gauss-Legendre points per sub-angle of a singular triangle
@@ -114,7 +141,7 @@ struct SingleLayerOptions {
   double tree_tolerance = 2e-6;  ///< tree: and when the far field's error estimate is below this (>= 0)
 };
 
-/// "all7" | "adaptive" | "tree"; the inverse throws bendlab::Error naming the unknown value.
+/// "all7" | "adaptive" | "tree" | "tree-mixed"; the inverse throws bendlab::Error naming the unknown value.
 std::string to_string(SingleLayerQuadrature q);
 SingleLayerQuadrature single_layer_quadrature(const std::string& name);
 
@@ -132,6 +159,11 @@ class StokesSingleLayer {
  private:
   void prepare(const Points& x, const Points& f) const;
   void prepare_tree(const Points& x) const;
+  /// tree_mixed: the single-precision copies of the leaves' points and the clusters' proxies.
+  void prepare_single_precision() const;
+  bool tree() const {
+    return options_.quadrature == SingleLayerQuadrature::tree || options_.quadrature == SingleLayerQuadrature::tree_mixed;
+  }
 
   TopologyPtr topology_;
   SingleLayerOptions options_;
@@ -158,6 +190,10 @@ class StokesSingleLayer {
   mutable std::vector<int> tree_count_;
   mutable std::vector<double> bcx_, bcy_, bcz_, tree_far2_;
   mutable std::vector<double> tpx_, tpy_, tpz_, tfx_, tfy_, tfz_;
+  // tree_mixed: the 7-point points relative to their leaf's box centre and the proxies relative
+  // to their cluster's, with their weights, in single precision (same layout as the doubles).
+  mutable std::vector<float> sqx_, sqy_, sqz_, sfx_, sfy_, sfz_;
+  mutable std::vector<float> spx_, spy_, spz_, spfx_, spfy_, spfz_;
 };
 
 /// The 7-point degree-5 rule on a triangle: barycentric coordinates (of corners 0, 1, 2) and
