@@ -616,11 +616,14 @@ def write_doc(a, runs, bim_runs, work, bim_work, cost, projected, totals):
           f"with {FINE_TRIANGLES} triangles (--fine-radii) is set beside the BIM at {FINE_TRIANGLES} triangles (RKC, tree quadrature)",
           "and, in its last cell, at 1280. The column p = 1 extrapolates the last two radii with the",
           "first-order convergence expected of the immersed boundary (its kernel shifts the surface by a",
-          "fraction of dx). The paper's size (R = 13.5, 5120 triangles, its own box) is shown in the 1280",
+          "fraction of dx). Where a series has more than three radii, the column \"last three\" fits the three",
+          "largest alone (the curve through them): how much D_inf depends on keeping the smallest radius",
+          "when chi2 is large. The paper's size (R = 13.5, 5120 triangles, its own box) is shown in the 1280",
           "rows but not fitted.", "",
           "| G | kB_hat | method | triangles | " + " | ".join(f"D (R = {fmt_g(R)})" for R in radii_all)
-          + " | D_inf (p) | 68 % range | chi2 | smallest R within 2 % | BIM | D_inf / BIM - 1 | within 3 % | D_inf, p = 1 (vs BIM) |",
-          "|---|---|---|---|" + "---|" * (len(radii_all) + 8)]
+          + " | D_inf (p) | 68 % range | chi2 | smallest R within 2 % | BIM | D_inf / BIM - 1 | within 3 % | D_inf, p = 1 (vs BIM) "
+          "| D_inf, last three (p; vs BIM) |",
+          "|---|---|---|---|" + "---|" * (len(radii_all) + 9)]
 
     def case_of(r):
         """(G, kB_hat, method, triangles of the series): the paper's size joins the 1280 rows."""
@@ -693,8 +696,14 @@ def write_doc(a, runs, bim_runs, work, bim_work, cost, projected, totals):
             (R1, D1), (R2, D2) = pts[-2], pts[-1]
             d_first = D2 - (D1 - D2) / (1 / R1 - 1 / R2) / R2
             first = f"{d_first:.4f}" + (f" ({100 * (d_first / bim_d - 1):+.1f} %)" if bim_d else "")
+        last3 = "-"
+        if len(pts) > 3:
+            f3 = fit_extrapolation([p[0] for p in pts[-3:]], [p[1] for p in pts[-3:]],
+                                   weights[-3:] if weights else None)
+            if f3:
+                last3 = f"{f3[0]:.4f} ({f3[2]:.2f}" + (f"; {100 * (f3[0] / bim_d - 1):+.1f} %)" if bim_d else ")")
         L.append(f"| {fmt_g(G)} | {fmt_g(kb)} | {m} | {tri} | " + " | ".join(cells)
-                 + f" | {fit_cell} | {spread_cell} | {chi_cell} | {within} | {bim} | {dev} | {check} | {first} |")
+                 + f" | {fit_cell} | {spread_cell} | {chi_cell} | {within} | {bim} | {dev} | {check} | {first} | {last3} |")
         # figure: D(gamma t), LBM at each R beside the BIM
         fig, ax = plt.subplots(figsize=(5.5, 3.6))
         any_line = False
