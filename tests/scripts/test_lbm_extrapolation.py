@@ -103,6 +103,12 @@ def test_placement_sigma_recovers_the_spread_of_one_placement():
     assert lbm_study.placement_sigma([]) is None
 
 
+def summary_of(run):
+    """The identity fields of a finished run's summary.json for `run` (default placement and kernel)."""
+    return {"solver": "lbm", "method": run.method, "mesh": f"mt1:{run.triangles}", "G": run.G,
+            "kappa_b_hat": run.kappa_b, "radius_lu": run.radius, "reynolds": run.reynolds, "box": list(run.box)}
+
+
 def test_placement_runs_are_named_and_started_apart_from_the_study():
     centred = lbm_study.LbmRun("B", 0.2, 0.15, 8.0, 5120, lbm_study.BOX, 10.0)
     moved = lbm_study.LbmRun("B", 0.2, 0.15, 8.0, 5120, lbm_study.BOX, 10.0, offset=0.5)
@@ -113,8 +119,7 @@ def test_placement_runs_are_named_and_started_apart_from_the_study():
     assert lbm_study.is_placement(moved) and not lbm_study.is_placement(centred)
     assert not lbm_study.is_check(moved)
     # A finished run's summary is matched with its own placement only.
-    summary = {"solver": "lbm", "method": "B", "mesh": "mt1:5120", "G": 0.2, "kappa_b_hat": 0.15,
-               "radius_lu": 8.0, "reynolds": 0.2, "box": list(lbm_study.BOX)}
+    summary = summary_of(centred)
     assert lbm_study.lbm_matches(summary, centred) and not lbm_study.lbm_matches(summary, moved)
     summary["offset"] = [0.5, 0.5, 0.5]
     assert lbm_study.lbm_matches(summary, moved) and not lbm_study.lbm_matches(summary, centred)
@@ -130,8 +135,7 @@ def test_kernel_check_runs_are_named_matched_and_kept_out_of_the_fit():
     assert lbm_study.is_check(wide) and not lbm_study.is_check(study)
     assert not lbm_study.is_placement(wide)
     # A summary names its kernel; one without the field is the default kernel's (older runs).
-    summary = {"solver": "lbm", "method": "A", "mesh": "mt1:1280", "G": 0.2, "kappa_b_hat": 0.15,
-               "radius_lu": 6.0, "reynolds": 0.2, "box": list(lbm_study.BOX)}
+    summary = summary_of(study)
     assert lbm_study.lbm_matches(summary, study) and not lbm_study.lbm_matches(summary, wide)
     summary["kernel"] = "phi4"
     assert lbm_study.lbm_matches(summary, wide) and not lbm_study.lbm_matches(summary, study)
