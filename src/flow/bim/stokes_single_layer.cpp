@@ -571,26 +571,35 @@ void StokesSingleLayer::prepare_tree(const Points& x) const {
   for (int j = tree_level_[split] - 1; j >= 0; --j) process(j);
 }
 
+namespace {
+// to[k] = from[k] - shift for k in [b, e), rounded to single precision.
+void to_single(const std::vector<double>& from, std::vector<float>& to, std::size_t b, std::size_t e, double shift) {
+  for (std::size_t k = b; k < e; ++k) to[k] = static_cast<float>(from[k] - shift);
+}
+}  // namespace
+
 void StokesSingleLayer::prepare_single_precision() const {
   const int nn = static_cast<int>(tree_begin_.size());
 #pragma omp parallel for schedule(static)
   for (int j = 0; j < nn; ++j) {
-    const double c[3] = {bcx_[j], bcy_[j], bcz_[j]};
-    auto convert = [&](const std::vector<double>* from[6], std::vector<float>* to[6], std::size_t b, std::size_t e) {
-      for (int a = 0; a < 6; ++a)
-        for (std::size_t k = b; k < e; ++k)
-          (*to[a])[k] = static_cast<float>(a < 3 ? (*from[a])[k] - c[a] : (*from[a])[k]);
-    };
+    // A leaf's 7-point points and a cluster's proxies relative to the box centre; weights as they are.
     if (tree_child_[j] < 0) {
-      const std::vector<double>* from[6] = {&qx_, &qy_, &qz_, &fx_, &fy_, &fz_};
-      std::vector<float>* to[6] = {&sqx_, &sqy_, &sqz_, &sfx_, &sfy_, &sfz_};
-      convert(from, to, 7 * static_cast<std::size_t>(tree_begin_[j]), 7 * static_cast<std::size_t>(tree_end_[j]));
+      const std::size_t b = 7 * static_cast<std::size_t>(tree_begin_[j]), e = 7 * static_cast<std::size_t>(tree_end_[j]);
+      to_single(qx_, sqx_, b, e, bcx_[j]);
+      to_single(qy_, sqy_, b, e, bcy_[j]);
+      to_single(qz_, sqz_, b, e, bcz_[j]);
+      to_single(fx_, sfx_, b, e, 0.0);
+      to_single(fy_, sfy_, b, e, 0.0);
+      to_single(fz_, sfz_, b, e, 0.0);
     }
     if (tree_count_[j] > 0) {
-      const std::vector<double>* from[6] = {&tpx_, &tpy_, &tpz_, &tfx_, &tfy_, &tfz_};
-      std::vector<float>* to[6] = {&spx_, &spy_, &spz_, &spfx_, &spfy_, &spfz_};
-      const std::size_t o = static_cast<std::size_t>(tree_proxy_[j]) * tree_count_[j];
-      convert(from, to, o, o + tree_count_[j]);
+      const std::size_t b = static_cast<std::size_t>(tree_proxy_[j]) * tree_count_[j], e = b + tree_count_[j];
+      to_single(tpx_, spx_, b, e, bcx_[j]);
+      to_single(tpy_, spy_, b, e, bcy_[j]);
+      to_single(tpz_, spz_, b, e, bcz_[j]);
+      to_single(tfx_, spfx_, b, e, 0.0);
+      to_single(tfy_, spfy_, b, e, 0.0);
+      to_single(tfz_, spfz_, b, e, 0.0);
     }
   }
 }
