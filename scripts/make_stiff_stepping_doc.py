@@ -100,9 +100,9 @@ def main():
         ref = min(refs, key=lambda r: r.get("rtol", 1)) if refs else None
         w(f"### {mesh}, Method {method}, G = {G}, κ̂_B = {kb}")
         w("")
-        w("| integrator | BIM quadrature | rtol / atol | γt reached | D_steady | D(2) | D(2) vs Cash-Karp | velocity evaluations"
+        w("| integrator | BIM quadrature | rtol / atol | γt reached | D_steady | D_steady vs Cash-Karp | D(2) | D(2) vs Cash-Karp | velocity evaluations"
           " (at the checkpoint for a running run) | evaluations per unit γt | fewer than Cash-Karp (per unit γt) | mean / max stages | ρ (last, ×1.1) | wall |")
-        w("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+        w("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
         for r in sorted(rs, key=lambda r: (r["integrator"] != "cash-karp", -r.get("rtol", 0))):
             ev = r.get("velocity_evaluations")
             per = ev / r["_t_counted"] if ev and r["_t_counted"] > 0 else None
@@ -113,13 +113,19 @@ def main():
             dev = None
             if ref and r is not ref and r["_D2"] is not None and ref["_D2"] is not None:
                 dev = (r["_D2"] - ref["_D2"]) / ref["_D2"]
+            # D_steady only where both runs reached gamma t = 10 (finished, with a summary).
+            dev_steady = None
+            if ref and r is not ref and r["_finished"] and ref["_finished"] and r.get("D_steady") and ref.get("D_steady"):
+                dev_steady = (r["D_steady"] - ref["D_steady"]) / ref["D_steady"]
             st = r.get("integrator_stats", {})
             stages = f"{st['mean_stages']:.1f} / {st['max_stages']}" if st else "–"
             rho = fmt(st.get("spectral_radius"), ".3g") if st else "–"
             wall = r.get("wall_seconds")
             state = "" if r["_finished"] else " (running)"
             w(f"| {r['integrator']}{state} | {r.get('bim_quadrature', 'all7')} | {r.get('rtol', '–')} / {r.get('atol', '–')} | {r['_t_reached']:.4g} | "
-              f"{fmt(r.get('D_steady'), '.6f')} | {fmt(r['_D2'], '.6f')} | "
+              f"{fmt(r.get('D_steady'), '.6f')} | "
+              f"{'reference' if r is ref else (fmt(100 * dev_steady, '+.4f') + '%' if dev_steady is not None else '–')} | "
+              f"{fmt(r['_D2'], '.6f')} | "
               f"{'reference' if r is ref else (fmt(100 * dev, '+.4f') + '%' if dev is not None else '–')} | "
               f"{fmt(ev, 'd')} | {fmt(per, '.0f')} | {fmt(gain, '.1f') + '×' if gain else '–'} | {stages} | {rho} | "
               f"{fmt(wall, '.0f')} s |")
