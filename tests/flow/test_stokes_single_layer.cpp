@@ -372,6 +372,27 @@ void expect_mixed_near_tree(int triangles, double bound) {
 
 TEST(StokesSingleLayer, TreeMixedWithinSinglePrecisionOfTreeAt1280) { expect_mixed_near_tree(1280, 1e-6); }
 
+TEST(StokesSingleLayer, TreeMixedPaddingToWholeBlocksAddsNothing) {
+  // Leaves of 1, 3 and 5 faces (7, 21, 35 points) and degrees 2, 3 and 5 (10, 20, 56 proxies):
+  // none a whole number of the kernel's blocks, so every range carries zero-weight padding. The
+  // single-precision sums stay as close to the double tree as with the default layout.
+  for (bool rbc : {true, false}) {
+    const Case c = quadrature_case(320, rbc);
+    for (const auto& [leaf, degree] : {std::pair{1, 2}, std::pair{3, 3}, std::pair{5, 5}}) {
+      SingleLayerOptions tree = tree_rule();
+      tree.tree_leaf_size = leaf;
+      tree.tree_order = degree;
+      SingleLayerOptions mixed = tree;
+      mixed.quadrature = SingleLayerQuadrature::tree_mixed;
+      const Points u = single_layer(c, mixed);
+      ASSERT_TRUE(u.allFinite());
+      const double e = relative_difference(u, single_layer(c, tree));
+      EXPECT_LT(e, 1e-6) << (rbc ? "red blood cell" : "ellipsoid") << ", leaf " << leaf << ", degree " << degree;
+      EXPECT_GT(e, 1e-12);
+    }
+  }
+}
+
 TEST(StokesSingleLayer, TreeMixedWithoutFarFieldNearAll7) {
   // Every face near: the 7-point rule over every face in single precision, against all7 in double.
   const Case c = quadrature_case(1280, true);

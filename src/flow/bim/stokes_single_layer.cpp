@@ -16,6 +16,12 @@
 
 namespace bendlab {
 
+namespace {
+// tree_mixed: the kernel sums blocks of this many points (one AVX-512 register of floats, two of
+// AVX2), every range padded to whole blocks.
+constexpr int kMixedBlock = 16;
+}  // namespace
+
 const TriangleRule7& triangle_rule7() {
   static const TriangleRule7 rule = [] {
     // Strang & Fix / Dunavant degree 5: centroid plus two orbits of three points.
@@ -152,9 +158,26 @@ StokesSingleLayer::StokesSingleLayer(TopologyPtr topology, SingleLayerOptions op
     for (auto* v : {&tpx_, &tpy_, &tpz_, &tfx_, &tfy_, &tfz_})
       v->assign(static_cast<std::size_t>(proxies) * padded, 0.0);
     if (options_.quadrature == SingleLayerQuadrature::tree_mixed) {
-      for (auto* v : {&sqx_, &sqy_, &sqz_, &sfx_, &sfy_, &sfz_}) v->assign(nq, 0.0f);
-      for (auto* v : {&spx_, &spy_, &spz_, &spfx_, &spfy_, &spfz_})
-        v->assign(static_cast<std::size_t>(proxies) * padded, 0.0f);
+      // One range per leaf (its 7-point points) and per proxy slot, each a whole number of blocks.
+      auto blocks = [](int n) { return (n + kMixedBlock - 1) / kMixedBlock * kMixedBlock; };
+      mixed_proxy_count_ = blocks(padded);
+      mixed_leaf_.assign(nn, -1);
+      mixed_leaf_count_.assign(nn, 0);
+      mixed_proxy_.assign(nn, -1);
+      int size = 0;
+      for (int j = 0; j < nn; ++j) {
+        if (tree_child_[j] < 0) {
+          mixed_leaf_[j] = size;
+          mixed_leaf_count_[j] = blocks(7 * (tree_end_[j] - tree_begin_[j]));
+          size += mixed_leaf_count_[j];
+        }
+        if (tree_proxy_[j] >= 0) {
+          mixed_proxy_[j] = size;
+          size += mixed_proxy_count_;
+        }
+      }
+      // Zero: the padding keeps zero weights (and, for proxies, the box centre) from here on.
+      for (auto* v : {&mx_, &my_, &mz_, &mfx_, &mfy_, &mfz_}) v->assign(size, 0.0f);
     }
     // The basis T_a(s_x) T_b(s_y) T_c(s_z), a + b + c <= q, and the reference points in
     // [-1, 1]^3: approximate Fekete points, the first nm columns that column-pivoted QR picks
@@ -261,15 +284,53 @@ void regular_sum(double xi, double yi, double zi, const double* __restrict qx, c
   regular_sum_body(xi, yi, zi, qx, qy, qz, fx, fy, fz, nq, out);
 }
 
-// tree_mixed: the points relative to a box centre and the target's offset (xi, yi, zi) from the
-// same centre; eight (AVX2) partial sums per vector register in float, returned in double.
+// tree_mixed: one target against a list of ranges of the single-precision arrays (a near leaf's
+// 7-point points or a far cluster's proxies), each range's points relative to its box centre and
+// (ox, oy, oz) the target's offset from that centre. Each range is summed in float in kMixedBlock
+// partial sums (one vector register of floats with AVX-512, two with AVX2), which are then added
+// to partial sums in double; the double lanes are added up once per target. Every range is a
+// whole number of blocks (zero weights pad it), so the loop has no remainder.
+struct MixedRange {
+  int start, count;
+  float ox, oy, oz;
+};
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
 __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
 #endif
-void regular_sum_single(float xi, float yi, float zi, const float* __restrict qx, const float* __restrict qy,
-                        const float* __restrict qz, const float* __restrict fx, const float* __restrict fy,
-                        const float* __restrict fz, int nq, double* out) {
-  regular_sum_body(xi, yi, zi, qx, qy, qz, fx, fy, fz, nq, out);
+void mixed_sums(const MixedRange* ranges, int nranges, const float* __restrict qx, const float* __restrict qy,
+                const float* __restrict qz, const float* __restrict fx, const float* __restrict fy,
+                const float* __restrict fz, double* out) {
+  constexpr int L = kMixedBlock;
+  double sx[L] = {}, sy[L] = {}, sz[L] = {};
+  for (int r = 0; r < nranges; ++r) {
+    const float xi = ranges[r].ox, yi = ranges[r].oy, zi = ranges[r].oz;
+    float ax[L] = {}, ay[L] = {}, az[L] = {};
+    // 64-bit indices: with 32-bit ones the vectoriser may pick narrower registers.
+    const std::int64_t k1 = static_cast<std::int64_t>(ranges[r].start) + ranges[r].count;
+    for (std::int64_t k0 = ranges[r].start; k0 < k1; k0 += L) {
+#pragma omp simd
+      for (std::int64_t l = 0; l < L; ++l) {
+        const std::int64_t k = k0 + l;
+        const float dx = qx[k] - xi, dy = qy[k] - yi, dz = qz[k] - zi;
+        const float s = 1.0f / std::sqrt(dx * dx + dy * dy + dz * dz);
+        const float fr = (fx[k] * dx + fy[k] * dy + fz[k] * dz) * s * s * s;
+        ax[l] += fx[k] * s + dx * fr;
+        ay[l] += fy[k] * s + dy * fr;
+        az[l] += fz[k] * s + dz * fr;
+      }
+    }
+#pragma omp simd
+    for (int l = 0; l < L; ++l) {
+      sx[l] += ax[l];
+      sy[l] += ay[l];
+      sz[l] += az[l];
+    }
+  }
+  double ux = 0, uy = 0, uz = 0;
+  for (int l = 0; l < L; ++l) ux += sx[l], uy += sy[l], uz += sz[l];
+  out[0] = ux;
+  out[1] = uy;
+  out[2] = uz;
 }
 
 // Proxy weights W_m = sum_beta C(beta, m) M_beta for m < nm (C row-major nm x nm), zero up to padded.
@@ -572,9 +633,22 @@ void StokesSingleLayer::prepare_tree(const Points& x) const {
 }
 
 namespace {
-// to[k] = from[k] - shift for k in [b, e), rounded to single precision.
-void to_single(const std::vector<double>& from, std::vector<float>& to, std::size_t b, std::size_t e, double shift) {
-  for (std::size_t k = b; k < e; ++k) to[k] = static_cast<float>(from[k] - shift);
+// Points (x, y, z) and weights (fx, fy, fz) at [b, e) to the single-precision arrays from o on,
+// the points relative to c.
+using Doubles = std::vector<double>;
+using Floats = std::vector<float>;
+void to_single(const Doubles& x, const Doubles& y, const Doubles& z, const Doubles& fx, const Doubles& fy,
+               const Doubles& fz, std::size_t b, std::size_t e, const std::array<double, 3>& c, std::size_t o,
+               Floats& sx, Floats& sy, Floats& sz, Floats& sfx, Floats& sfy, Floats& sfz) {
+  for (std::size_t k = b; k < e; ++k) {
+    const std::size_t m = k - b + o;
+    sx[m] = static_cast<float>(x[k] - c[0]);
+    sy[m] = static_cast<float>(y[k] - c[1]);
+    sz[m] = static_cast<float>(z[k] - c[2]);
+    sfx[m] = static_cast<float>(fx[k]);
+    sfy[m] = static_cast<float>(fy[k]);
+    sfz[m] = static_cast<float>(fz[k]);
+  }
 }
 }  // namespace
 
@@ -583,23 +657,23 @@ void StokesSingleLayer::prepare_single_precision() const {
 #pragma omp parallel for schedule(static)
   for (int j = 0; j < nn; ++j) {
     // A leaf's 7-point points and a cluster's proxies relative to the box centre; weights as they are.
-    if (tree_child_[j] < 0) {
+    const std::array<double, 3> centre{bcx_[j], bcy_[j], bcz_[j]};
+    if (mixed_leaf_[j] >= 0) {
       const std::size_t b = 7 * static_cast<std::size_t>(tree_begin_[j]), e = 7 * static_cast<std::size_t>(tree_end_[j]);
-      to_single(qx_, sqx_, b, e, bcx_[j]);
-      to_single(qy_, sqy_, b, e, bcy_[j]);
-      to_single(qz_, sqz_, b, e, bcz_[j]);
-      to_single(fx_, sfx_, b, e, 0.0);
-      to_single(fy_, sfy_, b, e, 0.0);
-      to_single(fz_, sfz_, b, e, 0.0);
+      const std::size_t o = mixed_leaf_[j];
+      to_single(qx_, qy_, qz_, fx_, fy_, fz_, b, e, centre, o, mx_, my_, mz_, mfx_, mfy_, mfz_);
+      // The padding: zero weights at the leaf's first point, which is never at a node (a node
+      // may sit at the box centre, where the kernel is infinite and zero times it not a number).
+      for (std::size_t k = o + (e - b); k < o + mixed_leaf_count_[j]; ++k) {
+        mx_[k] = mx_[o], my_[k] = my_[o], mz_[k] = mz_[o];
+        mfx_[k] = mfy_[k] = mfz_[k] = 0.0f;
+      }
     }
     if (tree_count_[j] > 0) {
+      // The padding past tree_count_ keeps its zero weights at the centre: proxies are summed
+      // only for targets at least tree_ratio box radii away.
       const std::size_t b = static_cast<std::size_t>(tree_proxy_[j]) * tree_count_[j], e = b + tree_count_[j];
-      to_single(tpx_, spx_, b, e, bcx_[j]);
-      to_single(tpy_, spy_, b, e, bcy_[j]);
-      to_single(tpz_, spz_, b, e, bcz_[j]);
-      to_single(tfx_, spfx_, b, e, 0.0);
-      to_single(tfy_, spfy_, b, e, 0.0);
-      to_single(tfz_, spfz_, b, e, 0.0);
+      to_single(tpx_, tpy_, tpz_, tfx_, tfy_, tfz_, b, e, centre, mixed_proxy_[j], mx_, my_, mz_, mfx_, mfy_, mfz_);
     }
   }
 }
@@ -626,36 +700,39 @@ void StokesSingleLayer::velocity(const Points& x, const Points& f, double mu, Po
   const auto& rc = t.ring_corners();
   const double scale = 1.0 / (8.0 * M_PI * mu);
 
-#pragma omp parallel for schedule(static)
+#pragma omp parallel
+  {
+  // tree_mixed: the ranges of one target (each cluster gives at most one).
+  std::vector<MixedRange> ranges(single ? tree_begin_.size() : 0);
+#pragma omp for schedule(static)
   for (int i = 0; i < nv; ++i) {
     const double xi = x(i, 0), yi = x(i, 1), zi = x(i, 2);
     // The regular rule over every triangle (the hot loop).
     double ux = 0, uy = 0, uz = 0, acc[3];
     if (single) {
-      // As the tree below, each leaf and each far cluster summed on its own, in single precision
-      // relative to its box centre (a far cluster without proxies by its leaves).
-      int stack[128], top = 0;
+      // As the tree below, each near leaf and each far cluster a range of its own, summed in
+      // single precision relative to its box centre (a far cluster without proxies by its leaves).
+      int stack[128], top = 0, nranges = 0;
       stack[top++] = 0;
       while (top > 0) {
         const int j = stack[--top];
         const double dx = bcx_[j] - xi, dy = bcy_[j] - yi, dz = bcz_[j] - zi;
         const bool far = dx * dx + dy * dy + dz * dz >= tree_far2_[j];
-        const auto ox = static_cast<float>(-dx), oy = static_cast<float>(-dy), oz = static_cast<float>(-dz);
+        int start = -1, count = 0;
         if (far && tree_count_[j] > 0) {
-          const std::size_t o = static_cast<std::size_t>(tree_proxy_[j]) * tree_count_[j];
-          regular_sum_single(ox, oy, oz, spx_.data() + o, spy_.data() + o, spz_.data() + o, spfx_.data() + o,
-                             spfy_.data() + o, spfz_.data() + o, tree_count_[j], acc);
-          ux += acc[0], uy += acc[1], uz += acc[2];
+          start = mixed_proxy_[j], count = mixed_proxy_count_;
         } else if (tree_child_[j] < 0) {
-          const std::size_t o = 7 * static_cast<std::size_t>(tree_begin_[j]);
-          regular_sum_single(ox, oy, oz, sqx_.data() + o, sqy_.data() + o, sqz_.data() + o, sfx_.data() + o,
-                             sfy_.data() + o, sfz_.data() + o, 7 * (tree_end_[j] - tree_begin_[j]), acc);
-          ux += acc[0], uy += acc[1], uz += acc[2];
+          start = mixed_leaf_[j], count = mixed_leaf_count_[j];
         } else {
           stack[top++] = tree_child_[j] + 1;
           stack[top++] = tree_child_[j];
+          continue;
         }
+        ranges[nranges++] = {start, count, static_cast<float>(-dx), static_cast<float>(-dy), static_cast<float>(-dz)};
       }
+      mixed_sums(ranges.data(), nranges, mx_.data(), my_.data(), mz_.data(), mfx_.data(), mfy_.data(), mfz_.data(),
+                 acc);
+      ux = acc[0], uy = acc[1], uz = acc[2];
     } else if (tree) {
       // Top down from the root: a far cluster by its proxies (or its 7-point points where it has
       // none), a near one by its children, a near leaf by its 7-point points. Faces taken
@@ -724,6 +801,7 @@ void StokesSingleLayer::velocity(const Points& x, const Points& f, double mu, Po
     u(i, 0) = scale * (ux + corr.x());
     u(i, 1) = scale * (uy + corr.y());
     u(i, 2) = scale * (uz + corr.z());
+  }
   }
 }
 

@@ -88,8 +88,8 @@
 //   centre (|y - c_j| <= rho_j), and the target's offset from that centre is formed in double
 //   before it is rounded, so every difference y_k - x_i carries an absolute error of about
 //   2^-24 rho_j (about 1e-6 relative for the nearest points of a 5120-triangle capsule, far less
-//   for the rest); each call sums one leaf or one cluster (at most a few hundred terms, eight
-//   partial sums in float), and the calls are summed in double. The ring triangles' 7-point
+//   for the rest); each leaf or cluster is summed on its own (at most a few hundred terms,
+//   16 partial sums in float), and those sums are added in double. The ring triangles' 7-point
 //   terms, which the polar rule replaces, are taken back in double: their single-precision
 //   values differ by that relative error. Measured in the tests (tests/flow/
 //   test_stokes_single_layer.cpp), max_i |u - u_ref| / max_i |u_ref|: 2.4e-7 (red blood cell) and
@@ -104,8 +104,17 @@
 //   1280 tree-mixed 1.03 / 1.10, tree 0.83 / 0.88. Before the moments kernel (same run otherwise):
 //   tree-mixed 1.80 / 2.00, tree 1.42 / 1.57. perf of one tree-mixed evaluation at 5120: the sums
 //   52 %, the traversal, the ring correction and the polar integrals (velocity()) 22 % and their
-//   sines and cosines 4 %, the moments 8 %, the boxes 5 %. So the 3x over all7 at 5120 is not
-//   reached here either.
+//   sines and cosines 4 %, the moments 8 %, the boxes 5 %.
+//   On an Intel Xeon with AVX-512 the sums were 69 % of an evaluation, and half of that was the
+//   scalar remainder loop: a leaf of 20 faces has 140 points, 8 vectors of 16 floats and 12
+//   points one at a time, and a cluster's 120 proxies leave 8. So the kernel now takes all the
+//   ranges of one node (near leaves and far clusters) in one call, each range padded with zero
+//   weights to whole blocks of 16 points (a leaf's padding sits at its first point, a cluster's
+//   at its centre, which its targets are far from), summed in 16 float lanes per range that are
+//   added to 16 double lanes, reduced once per node. Same bench command, that machine, one
+//   thread, the study's two runs on the two cores: tree-mixed 3.92 (red blood cell) / 3.70
+//   (ellipsoid) times all7 at 5120 triangles (1.62 / 1.59 at 1280), differences from all7 as
+//   before (2.2e-6 / 4.5e-7); thread processor time: 3.71 / 4.04. The double tree: 1.89 / 2.10.
 // - Triangles that contain x_i: polar coordinates (rho, phi) centred on x_i [118]. There
 //   G dS = (I + e e^T) / rho * rho drho dphi, the singularity cancels, and with f linear along
 //   each ray the radial integral is exact: int_0^rho_max f drho = rho_max (f(x_i) + f_edge(phi)) / 2.
@@ -190,10 +199,14 @@ class StokesSingleLayer {
   mutable std::vector<int> tree_count_;
   mutable std::vector<double> bcx_, bcy_, bcz_, tree_far2_;
   mutable std::vector<double> tpx_, tpy_, tpz_, tfx_, tfy_, tfz_;
-  // tree_mixed: the 7-point points relative to their leaf's box centre and the proxies relative
-  // to their cluster's, with their weights, in single precision (same layout as the doubles).
-  mutable std::vector<float> sqx_, sqy_, sqz_, sfx_, sfy_, sfz_;
-  mutable std::vector<float> spx_, spy_, spz_, spfx_, spfy_, spfz_;
+  // tree_mixed: in single precision, each leaf's 7-point points relative to its box centre and
+  // each cluster's proxies relative to its own, with their weights, in one set of arrays; each
+  // range padded with zero weights to a whole number of kernel blocks (kMixedBlock points), so
+  // that the kernel has no remainder loop. mixed_leaf_[j] and mixed_proxy_[j]: where cluster j's
+  // points and proxies begin (-1: none); mixed_leaf_count_[j]: its padded point count. Built once.
+  std::vector<int> mixed_leaf_, mixed_leaf_count_, mixed_proxy_;
+  int mixed_proxy_count_ = 0;
+  mutable std::vector<float> mx_, my_, mz_, mfx_, mfy_, mfz_;
 };
 
 /// The 7-point degree-5 rule on a triangle: barycentric coordinates (of corners 0, 1, 2) and
