@@ -115,6 +115,10 @@
 //   thread, the study's two runs on the two cores: tree-mixed 3.92 (red blood cell) / 3.70
 //   (ellipsoid) times all7 at 5120 triangles (1.62 / 1.59 at 1280), differences from all7 as
 //   before (2.2e-6 / 4.5e-7); thread processor time: 3.71 / 4.04. The double tree: 1.89 / 2.10.
+//   With the clones for x86-64-v4 left out (so the AVX2 clone runs, same machine, processor
+//   time): 3.48 / 3.81, and 3.33 / 3.62 before the padding. perf of one evaluation now: the sums
+//   52 %, traversal, ring correction and polar integrals 19 % (sines and cosines 3 %), moments
+//   9 %, boxes 8 %.
 // - Triangles that contain x_i: polar coordinates (rho, phi) centred on x_i [118]. There
 //   G dS = (I + e e^T) / rho * rho drho dphi, the singularity cancels, and with f linear along
 //   each ray the radial integral is exact: int_0^rho_max f drho = rho_max (f(x_i) + f_edge(phi)) / 2.
