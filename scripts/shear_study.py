@@ -898,8 +898,48 @@ def section_e(results, runs, fig_dir, rel, t_end, n, meta):
         lines.append(f"| {fmt_g(run.G)} | {kb} | {name} | {s['wall_seconds']:.0f} | {s['steps']} | "
                      f"{s.get('rejected_steps', '')} | {s.get('velocity_evaluations', '')} | "
                      f"{num(stat(s, 'mean_stages'), 3)} | {num(stat(s, 'spectral_radius_max'), 3)} | {dv:.1e} |")
-    lines += [f"| | | **all {len(runs)} runs** | **{run_wall:.0f}** | | | **{evals}** | | | |", "", E_END, ""]
+    lines += [f"| | | **all {len(runs)} runs** | **{run_wall:.0f}** | | | **{evals}** | | | |", ""]
+    lines += quadrature_cross_check(results, runs, meta.get("work"))
+    lines += [E_END, ""]
     return lines
+
+
+# Part (e)'s tree quadratures and the one each is checked against where both have run.
+OTHER_TREE = {"tree": "tree-mixed", "tree-mixed": "tree"}
+
+
+def quadrature_cross_check(results, runs, work):
+    """(e.7): the runs that finished with both tree quadratures (tree and tree-mixed, the
+    same terms summed in double and in single precision) side by side, where the work folder has
+    the other's finished run folders. Empty when it has none."""
+    other = OTHER_TREE.get(E_QUADRATURE)
+    if other is None or work is None:
+        return []
+    rows = []
+    for run in runs:
+        r = results.get(run)
+        if r is None or not r.ok:
+            continue
+        name = run.name[: -len(E_QUADRATURE)] + other
+        s = read_summary(work / name / "summary.json")
+        if s is None or s.get("bim_quadrature") != other or not summary_matches({**s, "bim_quadrature": E_QUADRATURE}, run):
+            continue
+        a, b = r.summary, s
+        kb = "2/15" if close(run.kappa_b, FIG17_KB) else fmt_g(run.kappa_b)
+        rows.append(f"| {fmt_g(run.G)} | {kb} | {'no bending' if run.method == 'none' else run.method} | "
+                    f"{a['D_steady']:.6f} | {b['D_steady']:.6f} | {a['D_steady'] / b['D_steady'] - 1:+.1e} | "
+                    f"{a['theta_steady'] / b['theta_steady'] - 1:+.1e} | {a.get('velocity_evaluations', '')} / "
+                    f"{b.get('velocity_evaluations', '')} | {a['wall_seconds']:.0f} / {b['wall_seconds']:.0f} |")
+    if not rows:
+        return []
+    return [f"### (e.7) Cross-check: the same runs with the {other} quadrature", "",
+            f"The runs of this section that also finished with `--bim-quadrature {other}` (folders ending "
+            f"in `_{other}` in the work folder): the steady values and their relative difference, BIM "
+            f"evaluations and wall time ({E_QUADRATURE} / {other}; the wall times come from different "
+            "loads of the shared machine).", "",
+            f"| G | kB_hat | method | D_steady, {E_QUADRATURE} | D_steady, {other} | D difference | "
+            f"theta difference | evaluations | wall s |",
+            "| --- | --- | --- | --- | --- | --- | --- | --- | --- |", *rows, ""]
 
 
 E_BEGIN = "<!-- rkc-study:begin -->"
@@ -1111,7 +1151,7 @@ def main():
     if parts == ["e"]:
         load_series(results, work)
         meta = dict(command=command, commit=commit, wall=wall, jobs=args.jobs,
-                    cores=len(os.sched_getaffinity(0)))
+                    cores=len(os.sched_getaffinity(0)), work=work)
         rel = os.path.relpath(fig_dir, doc.parent)
         block = "\n".join(section_e(results, runs_of["e"], fig_dir, rel, args.t_end, args.triangles_e, meta))
         text = doc.read_text() if doc.is_file() else (
