@@ -249,39 +249,35 @@ Vec3 polar_integral(const Vec3& x0, const Vec3& x1, const Vec3& x2, const Vec3& 
   return sum;
 }
 
-// Sum over all quadrature points y_k of the Stokeslet G(y_k, x) . f_k w_k for one target x, in
-// the precision Real (double; float for tree_mixed, see the header). Inlined into the two
-// functions below, each compiled three times (AVX-512, AVX2+FMA and baseline x86-64) and picked at
-// run time, so the same binary runs everywhere and uses 8- or 4-wide doubles (16 or 8 floats)
-// where the processor has them. The file is built with -fno-math-errno (so that sqrt vectorises)
-// and -ffp-contract=fast (FMA).
+// One Stokeslet term G(y, x) . F added to (ux, uy, uz): (dx, dy, dz) = y - x and (fx, fy, fz) =
+// F, the density times the quadrature weight, in the precision Real (double; float for
+// tree_mixed, see the header). Inlined into the kernels below, each compiled three times
+// (AVX-512, AVX2+FMA and baseline x86-64) and picked at run time, so the same binary runs
+// everywhere and uses 8- or 4-wide doubles (16 or 8 floats) where the processor has them. The
+// file is built with -fno-math-errno (so that sqrt vectorises) and -ffp-contract=fast (FMA).
 template <typename Real>
-[[gnu::always_inline]] inline void regular_sum_body(Real xi, Real yi, Real zi, const Real* __restrict qx,
-                                                    const Real* __restrict qy, const Real* __restrict qz,
-                                                    const Real* __restrict fx, const Real* __restrict fy,
-                                                    const Real* __restrict fz, int nq, double* out) {
-  Real ux = 0, uy = 0, uz = 0;
-#pragma omp simd reduction(+ : ux, uy, uz)
-  for (int k = 0; k < nq; ++k) {
-    const Real dx = qx[k] - xi, dy = qy[k] - yi, dz = qz[k] - zi;
-    const Real s = Real(1) / std::sqrt(dx * dx + dy * dy + dz * dz);
-    const Real fr = (fx[k] * dx + fy[k] * dy + fz[k] * dz) * s * s * s;
-    ux += fx[k] * s + dx * fr;
-    uy += fy[k] * s + dy * fr;
-    uz += fz[k] * s + dz * fr;
-  }
-  out[0] = ux;
-  out[1] = uy;
-  out[2] = uz;
+[[gnu::always_inline]] inline void add_stokeslet(Real dx, Real dy, Real dz, Real fx, Real fy, Real fz, Real& ux,
+                                                 Real& uy, Real& uz) {
+  const Real s = Real(1) / std::sqrt(dx * dx + dy * dy + dz * dz);
+  const Real fr = (fx * dx + fy * dy + fz * dz) * s * s * s;
+  ux += fx * s + dx * fr;
+  uy += fy * s + dy * fr;
+  uz += fz * s + dz * fr;
 }
 
+// Sum over the quadrature points y_k, k < nq, of the Stokeslet G(y_k, x) . f_k w_k for one target x.
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
 __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
 #endif
 void regular_sum(double xi, double yi, double zi, const double* __restrict qx, const double* __restrict qy,
                  const double* __restrict qz, const double* __restrict fx, const double* __restrict fy,
                  const double* __restrict fz, int nq, double* out) {
-  regular_sum_body(xi, yi, zi, qx, qy, qz, fx, fy, fz, nq, out);
+  double ux = 0, uy = 0, uz = 0;
+#pragma omp simd reduction(+ : ux, uy, uz)
+  for (int k = 0; k < nq; ++k) add_stokeslet(qx[k] - xi, qy[k] - yi, qz[k] - zi, fx[k], fy[k], fz[k], ux, uy, uz);
+  out[0] = ux;
+  out[1] = uy;
+  out[2] = uz;
 }
 
 // tree_mixed: one target against a list of ranges of the single-precision arrays (a near leaf's
@@ -311,12 +307,7 @@ void mixed_sums(const MixedRange* ranges, int nranges, const float* __restrict q
 #pragma omp simd
       for (std::int64_t l = 0; l < L; ++l) {
         const std::int64_t k = k0 + l;
-        const float dx = qx[k] - xi, dy = qy[k] - yi, dz = qz[k] - zi;
-        const float s = 1.0f / std::sqrt(dx * dx + dy * dy + dz * dz);
-        const float fr = (fx[k] * dx + fy[k] * dy + fz[k] * dz) * s * s * s;
-        ax[l] += fx[k] * s + dx * fr;
-        ay[l] += fy[k] * s + dy * fr;
-        az[l] += fz[k] * s + dz * fr;
+        add_stokeslet(qx[k] - xi, qy[k] - yi, qz[k] - zi, fx[k], fy[k], fz[k], ax[l], ay[l], az[l]);
       }
     }
 #pragma omp simd
