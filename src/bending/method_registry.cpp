@@ -20,18 +20,19 @@
 #include "bendlab/bending/loop_shell.hpp"
 #include "bendlab/bending/meyer.hpp"
 #include "bendlab/bending/mixed_ed.hpp"
+#include "bendlab/bending/monge_jet.hpp"
 
 namespace bendlab {
 
 namespace {
 
 /// The built-in methods, in the order of the paper's table 1 (then the conclusion's ED, then
-/// section 2.5's S, then J, which is not in the paper).
+/// section 2.5's S, then J and M, which are not in the paper).
 /// A new built-in method adds its line here.
 std::vector<MethodInfo> builtin_methods() {
   return {KantorNelson::info(), GompperKroll::info(), MeyerMethod::info(),
           BelkinMethod::info(), FarutinMethod::info(), MixedEDMethod::info(),
-          LoopShellMethod::info(), JulicherMethod::info()};
+          LoopShellMethod::info(), JulicherMethod::info(), MongeJetMethod::info()};
 }
 
 bool valid_name(const std::string& name) {

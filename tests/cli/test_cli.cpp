@@ -163,7 +163,7 @@ TEST_F(Cli, MethodsListsTheRegistryAsTableAndJson) {
                             "needs_admissible_mesh", "cost"})
       EXPECT_TRUE(m["capabilities"].contains(key)) << key;
   }
-  EXPECT_EQ(names, (std::vector<std::string>{"A", "B", "C", "D", "E", "ED", "S", "J"}));
+  EXPECT_EQ(names, (std::vector<std::string>{"A", "B", "C", "D", "E", "ED", "S", "J", "M"}));
   EXPECT_TRUE(j[6]["capabilities"]["needs_admissible_mesh"].get<bool>());
   EXPECT_TRUE(j[0]["capabilities"]["has_energy"].get<bool>());
   EXPECT_FALSE(j[2]["capabilities"]["has_energy"].get<bool>());

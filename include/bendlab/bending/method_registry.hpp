@@ -4,7 +4,7 @@
 // factory make_bending_method(), the CLI (`bendlab methods`, the --method choices), the RBC study's
 // default method list, the benchmarks and the tests that loop over all methods.
 //
-// Built-in methods (A, B, C, D, E, ED, S, J) are registered by the registry itself, from an explicit
+// Built-in methods (A, B, C, D, E, ED, S, J, M) are registered by the registry itself, from an explicit
 // list in src/bending/method_registry.cpp, the first time the table is read; each method's file
 // provides its entry (`static MethodInfo info()` beside `create()`). Adding a method is one new
 // file plus one line in that list. Code outside the library adds methods at run time with
@@ -82,7 +82,7 @@ struct BendingMethodRegistration {
   explicit BendingMethodRegistration(MethodInfo info) { register_bending_method(std::move(info)); }
 };
 
-/// Every registered method, built-ins first (A, B, C, D, E, ED, S, J), then in registration order.
+/// Every registered method, built-ins first (A, B, C, D, E, ED, S, J, M), then in registration order.
 /// A copy: the table may grow afterwards.
 std::vector<MethodInfo> bending_methods();
 /// The names of bending_methods(), in the same order.

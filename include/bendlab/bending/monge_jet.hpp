@@ -1,0 +1,92 @@
+#pragma once
+// Method M (Monge jet; ../shared/spec/METHOD_M.md): at every node a least-squares height function
+// of degree 5 (default) over the vertices within 3 edge-rings gives the normal, H, K and Lap_S H of
+// the fitted graph (graph_curvature.hpp), and then the force density of eq. (10),
+//   f = 2 kB (Lap H + 2 H (H^2 - K)) n,    F = f A_mixed (eq. (14)), as for C and E.
+// Unlike E, which fits a paraboloid and then a second paraboloid to the fitted H, M takes Lap H from
+// the same jet (its 3rd and 4th derivatives), so the O(h^2) noise of H is never differentiated twice:
+// its maximum errors of Lap H and f converge at second order on irregular meshes too.
+//
+// Per vertex i:
+// 1. Frame: n0 = the eigenvector of the smallest eigenvalue of sum_j (x_j - x_i)(x_j - x_i)^T over
+//    the 2-ring of i, signed to agree with the angle-weighted (MWA) normal; option frame =
+//    angle-weighted takes the MWA normal itself. t1, t2 complete a right-handed frame.
+// 2. Support: the vertices within `rings` edge-rings (i excluded; option support_rings), widened ring by ring while it has
+//    fewer than monge_jet_min_points(degree) points (24 for degree 5) or while the fit is singular.
+// 3. Fit: w = sum_{1 <= a+b <= degree} c_ab (u/s)^a (v/s)^b, s the RMS of |(u, v)| over the support;
+//    unweighted least squares (option gaussian_weights: weights exp(-|(u,v)|^2 / (2 s^2))); no
+//    constant term, the surface passes through x_i.
+// 4. Height derivatives at the node: d^a_u d^b_v h = a! b! c_ab / s^(a+b), orders 1 to 4.
+// 5. n, H, K, Lap_S H of the graph (graph_curvature.hpp); n is turned into world coordinates.
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "bendlab/bending/graph_curvature.hpp"
+#include "bendlab/bending/method_registry.hpp"
+#include "bendlab/core/types.hpp"
+#include "bendlab/mesh/topology.hpp"
+
+namespace bendlab {
+
+/// How the chart's normal n0 is chosen (step 1).
+enum class MongeFrame { Covariance, AngleWeighted };
+
+struct MongeJetSettings {
+  int degree = 5;                          ///< 4, 5 or 6
+  int rings = 3;                           ///< 2 or 3: the support before any widening
+  MongeFrame frame = MongeFrame::Covariance;
+  bool gaussian_weights = false;
+};
+
+/// Unknowns of a jet of this degree without constant term: (degree + 1)(degree + 2)/2 - 1.
+int monge_jet_unknowns(int degree);
+/// Fewest support points a fit accepts: unknowns + 4 (24 for degree 5, as the spec's 3-ring rule).
+int monge_jet_min_points(int degree);
+
+/// The fit at one node.
+struct MongeJetFit {
+  bool valid = false;        ///< false: the support does not determine the jet (see reason)
+  Vec3 t1 = Vec3::Zero(), t2 = Vec3::Zero(), n0 = Vec3::Zero();  ///< chart frame
+  double scale = 0;          ///< s, the RMS tangential distance of the support
+  HeightDerivatives derivatives;
+  Vec3 normal = Vec3::Zero();  ///< unit, world coordinates, on the side of n0
+  double H = 0, K = 0, lapH = 0;
+  int rings = 0;             ///< rings of the support used (set by monge_jet_fit)
+  int points = 0;            ///< support points used
+};
+
+/// The covariance normal of step 1: smallest-eigenvalue eigenvector of sum (x_j - x0)(x_j - x0)^T,
+/// signed so that its dot product with `orientation` is not negative.
+Vec3 covariance_normal(const Vec3& x0, std::span<const Vec3> points, const Vec3& orientation);
+
+/// Steps 3-5 at one node: the jet of `degree` fitted to `support` (positions, the node excluded) in
+/// the chart of unit normal n0. Invalid (valid = false) when there are fewer points than unknowns,
+/// or the normal matrix is numerically singular.
+MongeJetFit monge_jet_fit_point(const Vec3& x0, const Vec3& n0, std::span<const Vec3> support, int degree,
+                                bool gaussian_weights = false);
+
+/// The fit at every node, with the support rule of step 2 (rings widened where needed). Throws
+/// bendlab::Error naming the method and the first vertex that cannot be fitted (too few vertices in
+/// the whole connected mesh, or a singular system even with every vertex), before anything else.
+std::vector<MongeJetFit> monge_jet_fit(const Topology& topology, const Points& x, const Points& mwa_normal,
+                                       const MongeJetSettings& settings);
+
+/// Method M.
+class MongeJetMethod : public BendingMethod {
+ public:
+  explicit MongeJetMethod(MongeJetSettings settings = {});
+  static std::unique_ptr<BendingMethod> create(const MethodOptions& options);
+  /// The method's entry in the registry (method_registry.hpp): description, options, capabilities.
+  static MethodInfo info();
+
+  std::string name() const override { return "M"; }
+  BendingResult compute(const Topology& topology, const Points& x, double kappa_b) const override;
+  const MongeJetSettings& settings() const { return settings_; }
+
+ private:
+  MongeJetSettings settings_;
+};
+
+}  // namespace bendlab
