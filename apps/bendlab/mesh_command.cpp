@@ -24,8 +24,7 @@ struct MeshArgs {
 };
 
 void run_mesh(const MeshArgs& a) {
-  if (a.level < 0 || a.level > 8) throw Error(fmt::format("--level must be 0..8, got {}", a.level));
-  if (a.rivara < 0 || a.rivara > 6) throw Error(fmt::format("--rivara must be 0..6, got {}", a.rivara));
+  check_sphere_mesh_arguments(a.level, a.rivara, "--level", "--rivara");
   require_extension("--out", a.out, {".off", ".ply", ".obj", ".vtp"});
   require_writable_parent("--out", a.out);
   const auto surface = surface_from_options(a.shape, a.radius, a.axes);
