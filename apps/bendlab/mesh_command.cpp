@@ -54,8 +54,8 @@ const CommandRegistration registration([](CLI::App& app) {
   cmd->add_option("--family", args->family, "mt1 (Loop refinement of the icosahedron), mt2 (midpoint), "
                                              "octa (midpoint refinement of the octahedron)")
       ->check(CLI::IsMember({"mt1", "mt2", "octa"}, CLI::ignore_case))->capture_default_str();
-  cmd->add_option("--level", args->level, "refinement steps of the base (mt1 level 2 = 320 triangles)")->capture_default_str();
-  cmd->add_option("--rivara", args->rivara, "passes of Rivara's longest-edge bisection after refinement")->capture_default_str();
+  cmd->add_option("--level", args->level, "refinement steps of the base, 0..8 (mt1 level 2 = 320 triangles)")->capture_default_str();
+  cmd->add_option("--rivara", args->rivara, "passes of Rivara's longest-edge bisection after refinement, 0..6")->capture_default_str();
   cmd->add_option("--shape", args->shape, "sphere, rbc (eq. 15), oblate or prolate spheroid")
       ->check(CLI::IsMember({"sphere", "rbc", "oblate", "prolate"}))->capture_default_str();
   cmd->add_option("--radius", args->radius, "sphere radius, or the RBC's large half-axis R")->capture_default_str();
