@@ -1,12 +1,18 @@
 // bendlab: membrane bending forces on triangulated surfaces, and capsules in flow.
 // Started by mpirun or srun (in a build with BENDLAB_MPI), every rank runs the same command: MPI
-// is initialised here, only rank 0 prints notes and progress, and an error on any rank prints
-// its message (naming the rank) and ends every rank with MPI_Abort (docs/mpi.md).
+// is initialised here, and only rank 0 prints notes and progress. An error every rank met alike
+// is one line from rank 0 and a normal end of every rank; an error on some ranks prints its
+// message (naming the rank) and ends every rank with MPI_Abort (docs/mpi.md).
 #include <fmt/format.h>
 
+#include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
+#include <set>
+#include <string>
+#include <thread>
 #ifdef BENDLAB_HAVE_MPI
 #include <mpi.h>
 #endif
@@ -48,6 +54,20 @@ bool launched_by_mpi() {
 }
 #endif
 
+// CLI11 converts an empty value of a numeric option ("--level ''") to 0: every number option of
+// every subcommand refuses one instead, before the conversion.
+void refuse_empty_numbers(CLI::App& app) {
+  static const std::set<std::string> numeric = {"INT", "UINT", "FLOAT", "NUMBER"};
+  for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) {
+    for (CLI::Option* opt : sub->get_options([](CLI::Option*) { return true; }))
+      if (numeric.count(opt->get_type_name()) > 0)
+        opt->check(CLI::Validator(
+            [](std::string& value) { return value.empty() ? std::string("'' is not a number") : std::string(); },
+            "", "not empty"));
+    refuse_empty_numbers(*sub);
+  }
+}
+
 struct MpiSession {
   bool active = false;
   MpiSession(int& argc, char**& argv) {
@@ -66,6 +86,25 @@ struct MpiSession {
   ~MpiSession() {
 #ifdef BENDLAB_HAVE_MPI
     if (active) MPI_Finalize();
+#endif
+  }
+  // Whether every rank reached this call within a few seconds: an error that every rank met alike
+  // (the checks of the options and files, which run on every rank before any collective work).
+  // A rank waiting in a collective call of the work never arrives, and this returns false.
+  bool all_ranks_failed() {
+#ifdef BENDLAB_HAVE_MPI
+    if (!active) return false;
+    MPI_Request request;
+    MPI_Ibarrier(MPI_COMM_WORLD, &request);
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+    int done = 0;
+    while (!done && std::chrono::steady_clock::now() < deadline) {
+      MPI_Test(&request, &done, MPI_STATUS_IGNORE);
+      if (!done) std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+    return done != 0;
+#else
+    return false;
 #endif
   }
   // An error on one rank: the others may wait in a collective call, so every rank is ended.
@@ -88,6 +127,11 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.set_version_flag("--version", "bendlab 0.1.0");
   for (auto& setup : bendlab::cli::command_registry()) setup(app);
+  refuse_empty_numbers(app);
+  // A write beyond the file size limit (ulimit -f) then fails with EFBIG, which every writer
+  // reports as a write error naming the file (removing its temporary), instead of the signal
+  // ending the process and leaving the temporary behind.
+  std::signal(SIGXFSZ, SIG_IGN);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -97,8 +141,13 @@ int main(int argc, char** argv) {
     if (world.rank == 0) std::cerr << "bendlab: error: " << e.what() << " (see --help)" << std::endl;
     return e.get_exit_code();
   } catch (const std::exception& e) {
-    // Commands do their work in callbacks, which run inside parse().
-    // One write per line, so that the ranks' lines do not interleave.
+    // Commands do their work in callbacks, which run inside parse(). An error every rank met
+    // alike is said once, by rank 0, and every rank ends normally; an error of some ranks names
+    // the rank and ends them all. One write per line, so that the ranks' lines do not interleave.
+    if (world.size > 1 && mpi.all_ranks_failed()) {
+      if (world.rank == 0) std::fputs(fmt::format("bendlab: error: {}\n", e.what()).c_str(), stderr);
+      return 1;
+    }
     const std::string line = fmt::format("{}: error: {}\n", who, e.what());
     std::fputs(line.c_str(), stderr);
     std::fflush(stderr);

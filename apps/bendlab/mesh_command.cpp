@@ -24,8 +24,7 @@ struct MeshArgs {
 };
 
 void run_mesh(const MeshArgs& a) {
-  if (a.level < 0 || a.level > 8) throw Error(fmt::format("--level must be 0..8, got {}", a.level));
-  if (a.rivara < 0 || a.rivara > 6) throw Error(fmt::format("--rivara must be 0..6, got {}", a.rivara));
+  check_sphere_mesh_arguments(a.level, a.rivara, "--level", "--rivara");
   require_extension("--out", a.out, {".off", ".ply", ".obj", ".vtp"});
   require_writable_parent("--out", a.out);
   const auto surface = surface_from_options(a.shape, a.radius, a.axes);
@@ -55,8 +54,8 @@ const CommandRegistration registration([](CLI::App& app) {
   cmd->add_option("--family", args->family, "mt1 (Loop refinement of the icosahedron), mt2 (midpoint), "
                                              "octa (midpoint refinement of the octahedron)")
       ->check(CLI::IsMember({"mt1", "mt2", "octa"}, CLI::ignore_case))->capture_default_str();
-  cmd->add_option("--level", args->level, "refinement steps of the base (mt1 level 2 = 320 triangles)")->capture_default_str();
-  cmd->add_option("--rivara", args->rivara, "passes of Rivara's longest-edge bisection after refinement")->capture_default_str();
+  cmd->add_option("--level", args->level, "refinement steps of the base, 0..8 (mt1 level 2 = 320 triangles)")->capture_default_str();
+  cmd->add_option("--rivara", args->rivara, "passes of Rivara's longest-edge bisection after refinement, 0..6")->capture_default_str();
   cmd->add_option("--shape", args->shape, "sphere, rbc (eq. 15), oblate or prolate spheroid")
       ->check(CLI::IsMember({"sphere", "rbc", "oblate", "prolate"}))->capture_default_str();
   cmd->add_option("--radius", args->radius, "sphere radius, or the RBC's large half-axis R")->capture_default_str();

@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <optional>
 
 #include "bendlab/analysis/rbc_report.hpp"
 #include "bendlab/analysis/rbc_study.hpp"
@@ -23,7 +24,7 @@ struct RbcArgs {
   std::vector<std::string> families = {"mt1", "mt2", "octa", "inhomogeneous"};
   std::vector<std::string> methods = bending_method_names();
   int max_triangles = 81920;  // the paper's largest meshes; the whole study takes a few minutes
-  int rings = 0;  // 0: the methods' default
+  std::optional<int> rings;  // none: the methods' default
   std::string base = "default";
   std::string out;
   bool plots = true;
@@ -48,9 +49,9 @@ void run_rbc(const RbcArgs& a) {
   o.methods = a.methods;
   o.max_triangles = a.max_triangles;
   o.base = a.base;
-  if (a.rings != 0) {
-    if (a.rings < 1 || a.rings > 3) throw Error(fmt::format("--rings must be 1, 2 or 3, got {}", a.rings));
-    o.method_options["rings"] = std::to_string(a.rings);
+  if (a.rings) {
+    if (*a.rings < 1 || *a.rings > 3) throw Error(fmt::format("--rings must be 1, 2 or 3, got {}", *a.rings));
+    o.method_options["rings"] = std::to_string(*a.rings);
   }
   validate(o);
   if (a.out.empty()) throw Error("--out: no output folder given");
@@ -73,10 +74,11 @@ void run_rbc(const RbcArgs& a) {
   if (a.plots) {
     const std::vector<std::string> argv = {a.python, script.string(), out.string()};
     note(fmt::format("rbc: {}", fmt::join(argv, " ")));
+    // A plot not made is a warning (README, "Errors"): the data files are the results.
     const int status = run_helper_program(argv);
     if (status != 0)
-      throw Error(fmt::format("the plot script failed (status {}); the data files in {} are complete", status,
-                              out.string()));
+      note(fmt::format("warning: the plots were not made ({} exited with status {}); the data files in {} are complete",
+                       a.python, status, out.string()));
   }
 }
 

@@ -32,7 +32,7 @@ struct ShearArgs {
   std::optional<double> kappa_b_hat, kappa_b;
   int rings = 0;
   std::int64_t stop_after_steps = 0;
-  bool resume = false, plot = true;
+  bool resume = false, overwrite = false, plot = true;
   LatticeRunSpec lattice;  // --solver lbm
   // Which options the user gave (the other solver's options are refused).
   bool given_tolerance = false, given_lattice = false;
@@ -77,6 +77,7 @@ void shear(const ShearArgs& a) {
   spec.rtol = a.rtol;
   spec.atol = a.atol;
   spec.resume = a.resume;
+  spec.overwrite = a.overwrite;
   spec.stop_after_steps = a.stop_after_steps;
   ShearRunCallbacks callbacks;
   callbacks.on_note = note;
@@ -178,15 +179,23 @@ const CommandRegistration registration([](CLI::App& app) {
       ->delimiter(',')->expected(3)->capture_default_str()->each(lattice);
   cmd->add_option("--snapshot-every", args->snapshot_every, "gamma t between .vtp snapshots and checkpoints")
       ->capture_default_str();
-  cmd->add_flag("--resume", args->resume,
-                "continue the run in --out from its last checkpoint (--t-end must be later than the checkpoint's time)");
+  auto* resume = cmd->add_flag("--resume", args->resume,
+                               "continue the run in --out from its last checkpoint (--t-end must be later than the "
+                               "checkpoint's time)");
+  cmd->add_flag("--overwrite", args->overwrite,
+                "start a new run in an --out that holds another run, removing that run's files (timeseries.csv, "
+                "snapshots, checkpoint, summary, plot); without it such a folder is refused")
+      ->excludes(resume);
   cmd->add_option("--stop-after-steps", args->stop_after_steps,
                   "stop after this many accepted steps (no summary; continue with --resume)")
       ->check(CLI::NonNegativeNumber);
   cmd->add_flag("!--no-plot", args->plot, "do not draw D_theta.png");
   cmd->add_option("--plot-script", args->plot_script,
                   "plot_shear.py to draw D_theta.png with (default: found beside the executable)");
-  cmd->add_option("--out", args->out, "output folder (created if missing)")->required();
+  cmd->add_option("--out", args->out,
+                  "output folder (created if missing; its parent must exist); locked while the run owns it, so a "
+                  "second run into it is refused")
+      ->required();
   cmd->callback([args] { shear(*args); });
 });
 

@@ -7,6 +7,8 @@
 #include "arrays.hpp"
 #include "bendlab/bending/bending_method.hpp"
 #include "bendlab/bending/method_registry.hpp"
+#include "bendlab/bending/result_check.hpp"
+#include "bendlab/core/finite_check.hpp"
 #include "bendlab/mesh/trimesh.hpp"
 #include "bindings.hpp"
 
@@ -26,9 +28,9 @@ MethodOptions options_from(const py::dict& kwargs) {
   return o;
 }
 
-void require_kappa(double kappa_b) {
-  if (!std::isfinite(kappa_b) || kappa_b < 0) throw Error("kappa_b must be a finite number >= 0");
-}
+// The command line's checks (bendlab forces), word for word: a finite kappa_b >= 0 before the work,
+// and a result without NaN or infinity after it (kappa_b = 1e308 overflows the forces).
+void require_kappa(double kappa_b) { require_positive("kappa_b", kappa_b, true); }
 
 /// A method with the options it was made with (methods are immutable and may be shared).
 struct PyMethod {
@@ -99,7 +101,9 @@ void bind_bending(py::module_& m) {
           [](const PyMethod& p, const TriMesh& mesh, double kappa_b) {
             require_kappa(kappa_b);
             py::gil_scoped_release release;
-            return p.method->compute(mesh.topology(), mesh.positions(), kappa_b);
+            BendingResult r = p.method->compute(mesh.topology(), mesh.positions(), kappa_b);
+            require_finite_result(r, p.method->name());
+            return r;
           },
           py::arg("mesh"), py::arg("kappa_b") = 1.0,
           "Every per-vertex quantity: normal, H, K, lapH, force, force_density, area, energy.")
@@ -112,6 +116,7 @@ void bind_bending(py::module_& m) {
               py::gil_scoped_release release;
               p.method->forces(mesh.topology(), mesh.positions(), kappa_b, f);
             }
+            require_finite_rows(f, "method " + p.method->name() + ": F");
             return take(std::move(f));
           },
           py::arg("mesh"), py::arg("kappa_b") = 1.0, "Node forces F, (N, 3): what a flow solver needs.")

@@ -33,7 +33,8 @@ void bind_capsule(py::module_& m) {
          std::optional<double> kappa_b_hat, std::optional<double> kappa_b, double t_end, double snapshot_every,
          double rtol, double atol, bool resume, std::int64_t stop_after_steps, const py::object& progress,
          double progress_interval, const py::dict& method_options, const std::string& integrator,
-         const std::string& membrane, double skalak_c, const std::string& bim_quadrature) -> py::object {
+         const std::string& membrane, double skalak_c, const std::string& bim_quadrature,
+         bool overwrite) -> py::object {
         ShearRunSpec spec;
         spec.folder = folder;
         spec.method = method;
@@ -51,6 +52,7 @@ void bind_capsule(py::module_& m) {
         spec.rtol = rtol;
         spec.atol = atol;
         spec.resume = resume;
+        spec.overwrite = overwrite;
         spec.stop_after_steps = stop_after_steps;
 
         // Python errors raised in a callback, or Ctrl-C, stop the run at the next accepted step
@@ -92,7 +94,7 @@ void bind_capsule(py::module_& m) {
       py::arg("stop_after_steps") = 0, py::arg("progress") = py::none(), py::arg("progress_interval") = 2.0,
       py::arg("method_options") = py::dict(), py::arg("integrator") = "cash-karp",
       py::arg("membrane") = "neo-hookean", py::arg("skalak_c") = 1.0,
-      py::arg("bim_quadrature") = "all7",
+      py::arg("bim_quadrature") = "all7", py::arg("overwrite") = false,
       "Runs an initially spherical capsule (membrane law `membrane`: 'neo-hookean', eqs. 18-21, or 'skalak' "
       "with C = skalak_c; plus the bending method) in "
       "the shear flow u = gamma z e_x with the boundary integral method (eqs. 22-23), units R = mu = gamma "
@@ -101,7 +103,8 @@ void bind_capsule(py::module_& m) {
       "snapshots, checkpoint.json, summary.json) exactly as `bendlab shear` does. progress(dict) is called "
       "every progress_interval seconds. Returns summary.json's content, or None when stopped by "
       "stop_after_steps. Ctrl-C (or an exception in progress) stops the run at the next step and is raised; "
-      "the folder can then be resumed with resume=True.");
+      "the folder can then be resumed with resume=True. A folder holding another run is refused unless "
+      "overwrite=True (which removes that run's files); a folder a running run owns is refused.");
 
   m.def(
       "read_time_series",

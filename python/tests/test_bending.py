@@ -103,6 +103,19 @@ def test_bad_method_names_and_options_raise_value_error():
         bendlab.sphere_mesh("mt1", 1).with_positions(np.zeros((3, 3)))
 
 
+def test_the_module_applies_the_command_lines_checks():
+    # kappa_b = 1e308 overflows the forces: refused like `bendlab forces`, naming the quantity.
+    with pytest.raises(ValueError, match="not finite"):
+        bendlab.Method("C").compute(bendlab.sphere_mesh("mt1", 1), kappa_b=1e308)
+    with pytest.raises(ValueError, match="not finite"):
+        bendlab.Method("C").forces(bendlab.sphere_mesh("mt1", 1), kappa_b=1e308)
+    # The mesh sizes of `bendlab mesh --level 0..8 --rivara 0..6`.
+    with pytest.raises(ValueError, match="level must be 0..8"):
+        bendlab.sphere_mesh("mt1", level=9)
+    with pytest.raises(ValueError, match="rivara_passes must be 0..6"):
+        bendlab.sphere_mesh("mt1", level=1, rivara_passes=50)
+
+
 def rss_bytes():
     with open("/proc/self/statm") as f:
         return int(f.read().split()[1]) * resource.getpagesize()

@@ -93,3 +93,13 @@ def test_bad_parameters_raise_value_error_before_any_file(tmp_path):
     with pytest.raises(ValueError, match="rings"):
         bendlab.shear_run(tmp_path / "d", **dict(COMMON, method="E"), method_options={"rings": 9})
     assert not any((tmp_path / n).exists() for n in "abcd")
+
+
+def test_a_new_run_into_a_folder_holding_a_run_needs_overwrite(tmp_path):
+    quick = dict(COMMON, t_end=0.02, snapshot_every=0.01)
+    first = bendlab.shear_run(tmp_path / "run", **quick)
+    with pytest.raises(ValueError, match="overwrite"):
+        bendlab.shear_run(tmp_path / "run", **dict(quick, G=0.2))
+    assert bendlab.read_summary(tmp_path / "run") == first
+    second = bendlab.shear_run(tmp_path / "run", overwrite=True, **dict(quick, G=0.2))
+    assert second["G"] == 0.2

@@ -2,14 +2,18 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <optional>
+#include <regex>
 #include <set>
 
 #include "bendlab/capsule/capsule_shape.hpp"
 #include "bendlab/capsule/checkpoint.hpp"
 #include "bendlab/core/atomic_file.hpp"
+#include "bendlab/core/folder_lock.hpp"
 #include "bendlab/geometry/measures.hpp"
 #include "bendlab/mesh/mesh_io.hpp"
 
@@ -30,6 +34,26 @@ TimeSeriesRow capsule_sample(const MembraneModel& membrane, const Points& x, dou
   r.E_bend = eb ? *eb : std::numeric_limits<double>::quiet_NaN();
   r.E_elastic = membrane.elastic_energy(x);
   return r;
+}
+
+namespace {
+
+// The run's own files, apart from the solver's side files. D_theta.png is the command line's plot
+// of the run; it belongs to the run as much as the files it is drawn from.
+bool is_run_output(const std::string& name, const CapsuleSolver& solver) {
+  static const std::set<std::string> fixed = {"timeseries.csv", "checkpoint.json", "summary.json",
+                                              "timing.json",    "shapes.pvd",      "D_theta.png"};
+  static const std::regex snapshot_re(R"(snapshot_\d{5,}\.vtp)");
+  return fixed.count(name) > 0 || std::regex_match(name, snapshot_re) || solver.is_side_file(name);
+}
+
+}  // namespace
+
+bool is_run_file(const std::string& name, const CapsuleSolver& solver) {
+  if (is_run_output(name, solver)) return true;
+  // A temporary: "<output>.tmp" and a suffix (AtomicFile's random one, or none).
+  const std::size_t tmp = name.rfind(".tmp");
+  return tmp != std::string::npos && tmp > 0 && is_run_output(name.substr(0, tmp), solver);
 }
 
 std::string compare_arguments(const nlohmann::json& here, const nlohmann::json& saved) {
@@ -60,6 +84,91 @@ void check_options(const CapsuleRunOptions& o) {
     throw Error("capsule run: arguments and summary_fields must be JSON objects");
   if (fs::exists(o.folder) && !fs::is_directory(o.folder))
     throw Error(fmt::format("'{}' is a file, not a folder", o.folder.string()));
+  const fs::path parent = o.folder.has_parent_path() ? o.folder.parent_path() : fs::path(".");
+  if (!fs::exists(o.folder) && !fs::is_directory(parent))
+    throw Error(fmt::format("'{}': folder '{}' does not exist (a run creates its own folder only)",
+                            o.folder.string(), parent.string()));
+}
+
+// The names of the run's files in folder (temporaries included; folders are no run's), sorted.
+std::vector<std::string> run_files_in(const fs::path& folder, const CapsuleSolver& solver, bool temporaries_only) {
+  std::vector<std::string> names;
+  for (const auto& entry : fs::directory_iterator(folder)) {
+    const std::string name = entry.path().filename().string();
+    if (entry.is_directory() && !entry.is_symlink()) continue;
+    if (!is_run_file(name, solver)) continue;
+    if (temporaries_only && is_run_output(name, solver)) continue;
+    names.push_back(name);
+  }
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+void remove_files(const fs::path& folder, const std::vector<std::string>& names) {
+  for (const std::string& name : names) {
+    std::error_code ec;
+    fs::remove(folder / name, ec);
+    if (ec) throw Error(fmt::format("cannot remove '{}': {}", (folder / name).string(), ec.message()));
+  }
+}
+
+// The checkpoint's snapshot list: snapshot_00000.vtp, snapshot_00001.vtp, ... (every one this run
+// wrote, in order), the last at the checkpoint's time. A resume writes snapshot_<N>.vtp next (N
+// entries in the list), which a run killed between a snapshot and its checkpoint may have left;
+// a snapshot beyond it in the folder belongs to a later history than the checkpoint's and would be
+// overwritten. (The listed files need not be present: a study's run folder moves between machines
+// without them.)
+void check_snapshots(const CapsuleCheckpoint& c, const fs::path& folder, const std::string& source) {
+  if (c.snapshots.empty())
+    throw Error(fmt::format("{}: \"snapshots\" is empty; a checkpoint is written with a snapshot, so it lists one at "
+                            "least",
+                            source));
+  for (std::size_t k = 0; k < c.snapshots.size(); ++k) {
+    const std::string expected = fmt::format("snapshot_{:05d}.vtp", k);
+    if (c.snapshots[k].second != expected)
+      throw Error(fmt::format("{}: \"snapshots\" entry {} names '{}', expected '{}'", source, k, c.snapshots[k].second,
+                              expected));
+  }
+  static const std::regex snapshot_re(R"(snapshot_(\d{5,})\.vtp)");
+  for (const auto& entry : fs::directory_iterator(folder)) {
+    const std::string name = entry.path().filename().string();
+    std::smatch m;
+    if (std::regex_match(name, m, snapshot_re) && m[1].str().size() < 10 &&
+        std::stoll(m[1].str()) > static_cast<long long>(c.snapshots.size()))
+      throw Error(fmt::format("{}: \"snapshots\" lists {} snapshots but '{}' holds '{}', a later one; the resumed run "
+                              "would overwrite it",
+                              source, c.snapshots.size(), folder.string(), name));
+  }
+  const double last = c.snapshots.back().first;
+  if (std::abs(last - c.time) > 1e-12 * std::max(1.0, std::abs(c.time)))
+    throw Error(fmt::format("{}: the last of \"snapshots\" is at gamma t = {}, the checkpoint's \"time\" is {}",
+                            source, last, c.time));
+}
+
+// The kept rows of timeseries.csv against each other and the checkpoint: finite, positive steps
+// that add up to the times (to the digits the file keeps), the last at the checkpoint's time.
+// Returns the largest step.
+double check_kept_rows(const std::vector<TimeSeriesRow>& rows, double time, const fs::path& series,
+                       const std::string& checkpoint) {
+  double largest = 0;
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    const TimeSeriesRow& r = rows[k];
+    const std::int64_t line = static_cast<std::int64_t>(k) + 2;
+    if (!std::isfinite(r.t) || !std::isfinite(r.dt) || !(r.dt > 0))
+      throw Error(fmt::format("'{}' line {}: gamma_t {} and dt {} must be finite, dt positive", series.string(), line,
+                              r.t, r.dt));
+    if (k > 0) {
+      const double advanced = r.t - rows[k - 1].t;
+      if (std::abs(advanced - r.dt) > 1e-5 * r.dt + 1e-9 * std::abs(r.t))
+        throw Error(fmt::format("'{}' line {}: gamma_t advanced by {:.6g} since the row before, but dt is {:.6g}",
+                                series.string(), line, advanced, r.dt));
+    }
+    largest = std::max(largest, r.dt);
+  }
+  if (!rows.empty() && std::abs(rows.back().t - time) > 1e-9 * std::max(1.0, std::abs(time)))
+    throw Error(fmt::format("{}: \"time\" is {} and \"steps\" {}, but row {} of '{}' is at gamma t = {}", checkpoint,
+                            time, rows.size(), rows.size(), series.string(), rows.back().t));
+  return largest;
 }
 
 nlohmann::json finite_or_null(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
@@ -82,11 +191,34 @@ CapsuleRunResult run_capsule(CapsuleSolver& solver, const CapsuleRunOptions& o) 
   state.solver = solver.name();
   state.steady = SteadyStatistics(SteadyWindow::for_run(o.t_end));
 
+  // The folder is locked before anything in it is read or written. The process that writes no
+  // files (a parallel run's other ranks) takes no lock: the writing one holds it for the run.
+  std::optional<FolderLock> lock;
+  if (o.writes_files) {
+    if (!o.resume && !fs::exists(folder)) {
+      std::error_code ec;
+      fs::create_directory(folder, ec);
+      if (ec && !fs::is_directory(folder))
+        throw Error(fmt::format("cannot create the run folder '{}': {}", folder.string(), ec.message()));
+    }
+    if (fs::is_directory(folder)) lock.emplace(folder, "run folder");
+  }
+
   std::optional<TimeSeriesFile> series;
   if (o.resume) {
     if (!fs::exists(checkpoint_path))
       throw Error(fmt::format("resume: no checkpoint in '{}' to resume from", folder.string()));
     CapsuleCheckpoint saved = CapsuleCheckpoint::read(checkpoint_path, membrane.num_vertices());
+    for (const std::string& f : saved.solver_state.side_files)
+      if (!solver.is_side_file(f))
+        throw Error(fmt::format("{}: \"side_files\" names '{}', which is not a file of the {} solver",
+                                checkpoint_path.string(), f, solver.name()));
+    std::vector<TimeSeriesRow> kept;
+    if (o.writes_files) {
+      check_snapshots(saved, folder, checkpoint_path.string());
+      kept = read_time_series_head(series_path, saved.steps);
+    }
+    const double largest_step = check_kept_rows(kept, saved.time, series_path, checkpoint_path.string());
     if (const std::string diff = compare_arguments(o.arguments, saved.arguments); !diff.empty())
       throw Error(fmt::format("resume: the arguments differ from the run in '{}': {}", folder.string(), diff));
     if (!(o.t_end > saved.time))
@@ -98,7 +230,12 @@ CapsuleRunResult run_capsule(CapsuleSolver& solver, const CapsuleRunOptions& o) 
                               solver.name()));
     solver.restore_state(saved.positions, saved.time, saved.counters, saved.solver_state.fields, folder,
                          checkpoint_path.string());
-    if (o.writes_files) series.emplace(TimeSeriesFile::resume(series_path, saved.steps));
+    if (o.writes_files) {
+      solver.check_resumed_steps(largest_step, checkpoint_path.string());
+      // Everything is checked: from here on the folder changes.
+      remove_files(folder, run_files_in(folder, solver, true));
+      series.emplace(TimeSeriesFile::resume(series_path, saved.steps));
+    }
     const SteadyWindow window = SteadyWindow::for_run(o.t_end);
     if (o.writes_files && !(saved.steady.window() == window)) {
       note(fmt::format("t_end moved the steady window from [{}, {}] to [{}, {}]: its sums are recomputed from {}",
@@ -136,7 +273,7 @@ CapsuleRunResult run_capsule(CapsuleSolver& solver, const CapsuleRunOptions& o) 
     state.write(checkpoint_path);
     const std::set<std::string> keep(state.solver_state.side_files.begin(), state.solver_state.side_files.end());
     for (const std::string& f : old_side_files)
-      if (!keep.count(f)) {
+      if (!keep.count(f) && solver.is_side_file(f)) {
         std::error_code ec;
         fs::remove(folder / f, ec);
       }
@@ -144,7 +281,13 @@ CapsuleRunResult run_capsule(CapsuleSolver& solver, const CapsuleRunOptions& o) 
 
   if (!o.resume) {
     if (o.writes_files) {
-      fs::create_directories(folder);
+      const std::vector<std::string> old = run_files_in(folder, solver, false);
+      if (!old.empty() && !o.overwrite)
+        throw Error(fmt::format("'{}' holds another run ('{}'{}); continue it with --resume, or replace it with "
+                                "--overwrite",
+                                folder.string(), old.front(), old.size() > 1 ? fmt::format(" and {} more", old.size() - 1)
+                                                                             : std::string()));
+      remove_files(folder, old);
       series.emplace(TimeSeriesFile::create(series_path));
     }
     write_checkpoint(solver.positions(), solver.time());

@@ -20,16 +20,6 @@ std::string format_time_series_row(const TimeSeriesRow& r) {
 }
 
 namespace {
-std::ifstream open_series(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  if (!in) throw Error(fmt::format("cannot read '{}'", path.string()));
-  std::string header;
-  std::getline(in, header);
-  if (header != time_series_header())
-    throw Error(fmt::format("'{}': header is '{}', expected '{}'", path.string(), header, time_series_header()));
-  return in;
-}
-
 double parse_number(const std::string& s, const std::string& source, std::int64_t line) {
   if (s == "nan") return std::numeric_limits<double>::quiet_NaN();
   try {
@@ -39,6 +29,24 @@ double parse_number(const std::string& s, const std::string& source, std::int64_
   } catch (const std::exception&) {
   }
   throw Error(fmt::format("'{}' line {}: '{}' is not a number", source, line, s.substr(0, 40)));
+}
+
+TimeSeriesRow parse_row(const std::string& line, const std::string& source, std::int64_t n) {
+  std::vector<double> v;
+  std::istringstream s(line);
+  for (std::string cell; std::getline(s, cell, ',');) v.push_back(parse_number(cell, source, n));
+  if (v.size() != 8) throw Error(fmt::format("'{}' line {}: {} columns, expected 8", source, n, v.size()));
+  return {v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7]};
+}
+
+// The header line of text, checked; `pos` is set to the start of the first row.
+void check_header(const std::string& text, const std::string& source, std::size_t& pos) {
+  const std::size_t end = text.find('\n');
+  const std::string header = text.substr(0, end);
+  if (header != time_series_header())
+    throw Error(
+        fmt::format("'{}': header is '{}', expected '{}'", source, header.substr(0, 200), time_series_header()));
+  pos = end == std::string::npos ? text.size() : end + 1;
 }
 }  // namespace
 
@@ -51,13 +59,7 @@ std::vector<TimeSeriesRow> parse_time_series(const std::string& text, const std:
         fmt::format("'{}': header is '{}', expected '{}'", source, header.substr(0, 200), time_series_header()));
   std::vector<TimeSeriesRow> rows;
   std::string line;
-  for (std::int64_t n = 2; std::getline(in, line); ++n) {
-    std::vector<double> v;
-    std::istringstream s(line);
-    for (std::string cell; std::getline(s, cell, ',');) v.push_back(parse_number(cell, source, n));
-    if (v.size() != 8) throw Error(fmt::format("'{}' line {}: {} columns, expected 8", source, n, v.size()));
-    rows.push_back({v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7]});
-  }
+  for (std::int64_t n = 2; std::getline(in, line); ++n) rows.push_back(parse_row(line, source, n));
   return rows;
 }
 
@@ -77,17 +79,30 @@ TimeSeriesFile TimeSeriesFile::create(const std::filesystem::path& path) {
   return TimeSeriesFile(path, 0);
 }
 
-TimeSeriesFile TimeSeriesFile::resume(const std::filesystem::path& path, std::int64_t rows) {
-  std::ifstream in = open_series(path);
-  AtomicFile f(path);
-  f.stream() << time_series_header() << '\n';
-  std::string line;
+std::vector<TimeSeriesRow> read_time_series_head(const std::filesystem::path& path, std::int64_t rows,
+                                                 std::size_t* bytes) {
+  const std::string text = read_regular_file(path, "the time series");
+  std::size_t pos = 0;
+  check_header(text, path.string(), pos);
+  std::vector<TimeSeriesRow> kept;
   for (std::int64_t k = 0; k < rows; ++k) {
-    if (!std::getline(in, line) || in.eof())
+    const std::size_t end = text.find('\n', pos);
+    if (end == std::string::npos)
       throw Error(fmt::format("'{}' has {} complete rows, the checkpoint needs {}", path.string(), k, rows));
-    f.stream() << line << '\n';
+    kept.push_back(parse_row(text.substr(pos, end - pos), path.string(), k + 2));
+    pos = end + 1;
   }
-  in.close();
+  if (bytes) *bytes = pos;
+  return kept;
+}
+
+TimeSeriesFile TimeSeriesFile::resume(const std::filesystem::path& path, std::int64_t rows) {
+  std::size_t bytes = 0;
+  read_time_series_head(path, rows, &bytes);
+  const std::string text = read_regular_file(path, "the time series");
+  if (text.size() < bytes) throw Error(fmt::format("'{}' changed while it was read", path.string()));
+  AtomicFile f(path);
+  f.stream().write(text.data(), static_cast<std::streamsize>(bytes));
   f.commit();
   return TimeSeriesFile(path, rows);
 }

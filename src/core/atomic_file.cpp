@@ -1,32 +1,56 @@
 #include "bendlab/core/atomic_file.hpp"
 
+#include <fcntl.h>
 #include <fmt/format.h>
+#include <sys/stat.h>
 #include <unistd.h>
+
+#include <cerrno>
+#include <cstdlib>
+#include <cstring>
+#include <vector>
 
 #include "bendlab/core/types.hpp"
 
 namespace bendlab {
 
-AtomicFile::AtomicFile(std::filesystem::path target, bool binary) : target_(std::move(target)) {
-  temp_ = target_;
-  temp_ += fmt::format(".tmp{}", static_cast<long>(::getpid()));
-  out_.open(temp_, binary ? std::ios::out | std::ios::binary | std::ios::trunc : std::ios::out | std::ios::trunc);
-  if (!out_) throw Error(fmt::format("cannot write '{}'", target_.string()));
+std::string atomic_temp_prefix(const std::filesystem::path& target) { return target.filename().string() + ".tmp"; }
+
+AtomicFile::AtomicFile(std::filesystem::path target, bool binary) : target_(std::move(target)), out_(nullptr) {
+  std::filesystem::path pattern = target_;
+  pattern.replace_filename(atomic_temp_prefix(target_) + "XXXXXX");
+  const std::string pattern_text = pattern.string();
+  std::vector<char> name(pattern_text.begin(), pattern_text.end());
+  name.push_back('\0');
+  const int fd = ::mkostemp(name.data(), O_CLOEXEC);
+  if (fd < 0) throw Error(fmt::format("cannot write '{}': {}", target_.string(), std::strerror(errno)));
+  temp_ = name.data();
+  // mkstemp makes the file 0600; an output gets the permissions a plain open() would give it.
+  const mode_t mask = ::umask(0);
+  ::umask(mask);
+  (void)::fchmod(fd, 0666 & ~mask);
+  // The buffer owns the descriptor from here on and closes it.
+  buffer_ = std::make_unique<__gnu_cxx::stdio_filebuf<char>>(
+      fd, binary ? std::ios::out | std::ios::binary : std::ios::out, static_cast<std::size_t>(BUFSIZ));
+  out_.rdbuf(buffer_.get());
   out_.precision(17);
 }
 
 AtomicFile::~AtomicFile() {
   if (!committed_) {
-    out_.close();
+    out_.rdbuf(nullptr);
+    buffer_.reset();
     std::error_code ec;
     std::filesystem::remove(temp_, ec);
   }
 }
 
 void AtomicFile::commit() {
+  // A write past the file size limit (ulimit -f) fails with EFBIG once SIGXFSZ is ignored (the
+  // command line does so): it lands here as a write error, and the destructor removes the file.
   out_.flush();
-  if (!out_) throw Error(fmt::format("error while writing '{}'", target_.string()));
-  out_.close();
+  if (!out_ || buffer_->close() == nullptr)
+    throw Error(fmt::format("error while writing '{}'", target_.string()));
   std::error_code ec;
   std::filesystem::rename(temp_, target_, ec);
   if (ec) throw Error(fmt::format("cannot write '{}': {}", target_.string(), ec.message()));

@@ -9,6 +9,7 @@
 #include "bendlab/bending/method_registry.hpp"
 #include "bendlab/capsule/run_tolerances.hpp"
 #include "bendlab/capsule/shear_units.hpp"
+#include "bendlab/core/file_input.hpp"
 #include "bendlab/core/finite_check.hpp"
 #include "bendlab/elasticity/elastic_law.hpp"
 #include "bendlab/flow/bim/bim_capsule_solver.hpp"
@@ -34,8 +35,8 @@ std::string method_list() {
 /// argument too; this names the law in words before anything else is compared.
 void check_resumed_membrane(const ShearRunSpec& a) {
   const fs::path path = a.folder / "checkpoint.json";
-  std::ifstream in(path);
-  const nlohmann::json saved = nlohmann::json::parse(in, nullptr, false);
+  // Read as a regular file only (a FIFO would block, a folder gives no text); the error names it.
+  const nlohmann::json saved = nlohmann::json::parse(read_regular_file(path, "the checkpoint"), nullptr, false);
   if (saved.is_discarded() || !saved.is_object() || !saved.contains("arguments") || !saved["arguments"].is_object())
     return;  // run_capsule refuses an unreadable checkpoint with its own message
   const nlohmann::json& args = saved["arguments"];
@@ -97,6 +98,10 @@ CapsuleRunResult run_shear(const ShearRunSpec& a, const ShearRunCallbacks& callb
   if (a.folder.empty()) throw Error("--out: no run folder given");
   if (fs::exists(a.folder) && !fs::is_directory(a.folder))
     throw Error(fmt::format("--out '{}' is a file, not a folder", a.folder.string()));
+  const fs::path parent = a.folder.has_parent_path() ? a.folder.parent_path() : fs::path(".");
+  if (!fs::exists(a.folder) && !fs::is_directory(parent))
+    throw Error(fmt::format("--out '{}': folder '{}' does not exist", a.folder.string(), parent.string()));
+  if (a.resume && a.overwrite) throw Error("--resume and --overwrite exclude each other");
   if (a.resume && !fs::exists(a.folder / "checkpoint.json"))
     throw Error(fmt::format("--resume: no checkpoint in '{}' to resume from", a.folder.string()));
   if (a.resume) check_resumed_membrane(a);
@@ -198,6 +203,7 @@ CapsuleRunResult run_shear(const ShearRunSpec& a, const ShearRunCallbacks& callb
   o.t_end = a.t_end;
   o.snapshot_every = a.snapshot_every;
   o.resume = a.resume;
+  o.overwrite = a.overwrite;
   o.stop_after_steps = a.stop_after_steps;
   // The run's identity (checked on resume): every option given; "rings" also on its own, as the
   // command line has always recorded it (the value given, 0 for the method's default).

@@ -228,10 +228,15 @@ TriMesh rivara_pass(const TriMesh& mesh, bool project_to_unit_sphere) {
   return b.result();
 }
 
+void check_sphere_mesh_arguments(int level, int rivara_passes, const std::string& level_name,
+                                 const std::string& rivara_name) {
+  if (level < 0 || level > 8) throw Error(level_name + " must be 0..8, got " + std::to_string(level));
+  if (rivara_passes < 0 || rivara_passes > 6)
+    throw Error(rivara_name + " must be 0..6, got " + std::to_string(rivara_passes));
+}
+
 TriMesh sphere_mesh(MeshFamily family, int level, int rivara_passes) {
-  if (level < 0) throw Error("sphere_mesh: refinement level must be >= 0, got " + std::to_string(level));
-  if (rivara_passes < 0)
-    throw Error("sphere_mesh: number of Rivara passes must be >= 0, got " + std::to_string(rivara_passes));
+  check_sphere_mesh_arguments(level, rivara_passes);
   TriMesh m = family == MeshFamily::Octa ? octahedron() : icosahedron();
   for (int k = 0; k < level; ++k) m = family == MeshFamily::MT1 ? refine_loop(m) : refine_midpoint(m);
   for (int p = 0; p < rivara_passes; ++p) m = rivara_pass(m);

@@ -3,6 +3,8 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <numeric>
+#include <vector>
 
 #include "bendlab/mesh/enclosed_volume.hpp"
 
@@ -46,6 +48,31 @@ void validate_geometry(const Topology& topology, const Points& x) {
 
 namespace {
 
+// One closed surface: every face reachable from face 0 across edges. Two disjoint spheres pass
+// every other check, and would give a capsule's shape measures of a body that does not exist.
+// Both constructors check it (a mesh is one component, as Topology::build's checks are local).
+void check_connected(const Topology& topology) {
+  const int nf = topology.num_faces();
+  std::vector<int> parent(static_cast<std::size_t>(nf));
+  std::iota(parent.begin(), parent.end(), 0);
+  auto root = [&](int f) {
+    while (parent[f] != f) f = parent[f] = parent[parent[f]];
+    return f;
+  };
+  const auto& ef = topology.edge_faces();
+  for (Eigen::Index e = 0; e < ef.rows(); ++e) parent[root(ef(e, 0))] = root(ef(e, 1));
+  int components = 0, other = -1;
+  for (int f = 0; f < nf; ++f)
+    if (root(f) == f) {
+      ++components;
+      if (root(0) != f) other = f;
+    }
+  if (components > 1)
+    throw Error(fmt::format("several components: the mesh has {} connected components (face {} is not connected "
+                            "to face 0); it must be one closed surface",
+                            components, other));
+}
+
 void check_outward(const Topology& topology, const Points& x) {
   const double v = enclosed_volume(topology, x);
   if (!(v > 0))
@@ -59,6 +86,7 @@ void check_outward(const Topology& topology, const Points& x) {
 TriMesh::TriMesh(Points positions, const Faces& faces, MeshOptions options)
     : topology_(Topology::build(static_cast<int>(positions.rows()), faces)), positions_(std::move(positions)) {
   validate_geometry(*topology_, positions_);
+  check_connected(*topology_);
   if (options.flip_inward && enclosed_volume(*topology_, positions_) < 0) {
     Faces flipped = faces;
     flipped.col(1).swap(flipped.col(2));
@@ -70,6 +98,7 @@ TriMesh::TriMesh(Points positions, const Faces& faces, MeshOptions options)
 TriMesh::TriMesh(TopologyPtr topology, Points positions)
     : topology_(std::move(topology)), positions_(std::move(positions)) {
   validate_geometry(*topology_, positions_);
+  check_connected(*topology_);
   check_outward(*topology_, positions_);
 }
 

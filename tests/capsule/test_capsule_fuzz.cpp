@@ -14,6 +14,7 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <random>
 #include <string>
@@ -153,4 +154,115 @@ TEST(CapsuleReaderFuzz, EveryMutatedTimeSeriesIsAcceptedOrRefusedWithError) {
   EXPECT_GT(out.refused, 0);
   std::cout << "[ info ] " << n << " time-series inputs: " << out.accepted << " accepted, " << out.refused
             << " refused\n";
+}
+
+namespace {
+
+void spit(const fs::path& p, const std::string& text) { std::ofstream(p, std::ios::binary) << text; }
+
+std::string read_or_empty(const fs::path& p) {
+  std::error_code ec;
+  return fs::is_regular_file(p, ec) ? read_regular_file(p) : std::string();
+}
+
+}  // namespace
+
+// A resume reads back checkpoint.json and timeseries.csv and checks them against each other and
+// the folder. Seeded with the cases that were once accepted (issue 29: dt_next 0 or 1e308, a
+// time after the last row, steps lowered, a side file naming the time series, an empty or
+// shortened snapshot list, a garbage or 7-column kept row), which must be refused, then mutated
+// further: every input is resumed (one step) or refused with bendlab::Error, and a refusal
+// leaves both files as they were.
+TEST(CapsuleReaderFuzz, EveryMutatedResumeIsResumedOrRefusedBeforeAnyChange) {
+  const fs::path root = fs::temp_directory_path() / ("bendlab_resume_fuzz_" + std::to_string(::getpid()));
+  fs::remove_all(root);
+  fs::create_directories(root);
+  MembraneParameters p;
+  p.kS = ShearUnits::from(0.1, 0.0, std::nullopt).kS();
+  auto membrane = std::make_shared<const MembraneModel>(sphere_mesh(MeshFamily::MT1, kLevel), p);
+  CapsuleRunOptions o;
+  o.folder = root / "base";
+  o.t_end = 0.003;
+  o.snapshot_every = 0.001;
+  o.arguments = {{"solver", "bim"}, {"G", 0.1}, {"kappa_b_hat", 0.0}};
+  {
+    BimCapsuleSolver solver(membrane);
+    ASSERT_TRUE(run_capsule(solver, o).finished);
+  }
+  const std::string checkpoint = read_regular_file(o.folder / "checkpoint.json");
+  const std::string series = read_regular_file(o.folder / "timeseries.csv");
+  const nlohmann::json seed = nlohmann::json::parse(checkpoint);
+  const std::size_t row2 = series.find('\n', series.find('\n') + 1) + 1;
+  const std::string after_row2 = series.substr(series.find('\n', row2) + 1);
+
+  auto edited = [&](auto edit) {
+    nlohmann::json j = seed;
+    edit(j);
+    return j.dump();
+  };
+  const std::vector<std::pair<std::string, std::string>> must_refuse = {
+      {edited([](auto& j) { j["solver_state"]["dt_next"] = 0; }), series},
+      {edited([](auto& j) { j["solver_state"]["dt_next"] = 1e308; }), series},
+      {edited([](auto& j) {
+         j["time"] = j["time"].template get<double>() + 0.0005;  // still before the resumed t_end
+         j["snapshots"].back()[0] = j["time"];
+       }),
+       series},
+      {edited([](auto& j) { j["steps"] = j["steps"].template get<int>() - 1; }), series},
+      {edited([](auto& j) { j["side_files"] = {"timeseries.csv"}; }), series},
+      {edited([](auto& j) { j["snapshots"] = nlohmann::json::array(); }), series},
+      {edited([](auto& j) { j["snapshots"].erase(j["snapshots"].size() - 1); }), series},
+      {checkpoint, series.substr(0, row2) + "garbage\n" + after_row2},
+      {checkpoint, series.substr(0, row2) + "0.001,0.1,0.2,4,12,nan,0.5\n" + after_row2},
+  };
+
+  const fs::path work = root / "work";
+  auto resume = [&](const std::string& cp, const std::string& ts) {
+    fs::remove_all(work);
+    fs::copy(o.folder, work);
+    spit(work / "checkpoint.json", cp);
+    spit(work / "timeseries.csv", ts);
+    BimCapsuleSolver solver(membrane);
+    CapsuleRunOptions r = o;
+    r.folder = work;
+    r.resume = true;
+    r.t_end = 0.004;
+    r.stop_after_steps = 1;
+    run_capsule(solver, r);
+  };
+  for (std::size_t k = 0; k < must_refuse.size(); ++k) {
+    EXPECT_THROW(resume(must_refuse[k].first, must_refuse[k].second), Error) << "seed " << k;
+    EXPECT_EQ(read_or_empty(work / "timeseries.csv"), must_refuse[k].second) << "seed " << k;
+    EXPECT_EQ(read_or_empty(work / "checkpoint.json"), must_refuse[k].first) << "seed " << k;
+  }
+
+  const long n = inputs_per_reader(5000) / 25;  // each input is a resume: 200 by default
+  std::mt19937_64 rng(20261204);
+  Outcome out;
+  for (long i = 0; i < n; ++i) {
+    const auto& [cp_seed, ts_seed] = must_refuse[rng() % must_refuse.size()];
+    std::string cp = cp_seed, ts = ts_seed;
+    switch (rng() % 3) {
+      case 0: cp = mutate_structure(nlohmann::json::parse(cp_seed), rng); break;
+      case 1: ts = mutate_file(ts_seed, rng); break;
+      default: cp = checkpoint, ts = i % 2 == 0 ? series : mutate_file(series, rng); break;
+    }
+    try {
+      resume(cp, ts);
+      ++out.accepted;
+    } catch (const Error& e) {
+      ++out.refused;
+      // A refusal comes before any change; only a run that failed while stepping has written.
+      if (std::string(e.what()).find("the run failed after step") == std::string::npos) {
+        ASSERT_EQ(read_or_empty(work / "timeseries.csv"), ts) << "input " << i << ": " << e.what();
+        ASSERT_EQ(read_or_empty(work / "checkpoint.json"), cp) << "input " << i << ": " << e.what();
+      }
+    } catch (const std::exception& e) {
+      FAIL() << "input " << i << ": not a bendlab::Error: " << e.what() << "\n" << cp.substr(0, 2000);
+    }
+  }
+  EXPECT_GT(out.accepted, 0);
+  EXPECT_GT(out.refused, 0);
+  std::cout << "[ info ] " << n << " resumes: " << out.accepted << " resumed, " << out.refused << " refused\n";
+  fs::remove_all(root);
 }

@@ -13,6 +13,7 @@
 #include "bendlab/capsule/shear_units.hpp"
 #include "bendlab/capsule/steady_statistics.hpp"
 #include "bendlab/core/finite_check.hpp"
+#include "bendlab/core/folder_lock.hpp"
 #include "bendlab/flow/bim/bim_capsule_solver.hpp"
 #include "bendlab/mesh/generators.hpp"
 
@@ -248,14 +249,152 @@ TEST_F(CapsuleRun, CheckpointIsValidatedAsAWhole) {
       EXPECT_NE(std::string(e.what()).find("G is 0.1 here but 0.2"), std::string::npos) << e.what();
     }
   }
-  // An empty snapshot list is valid (nothing to continue counting from) and does not crash.
-  spit(cp, edited([](auto& j) { j["snapshots"] = nlohmann::json::array(); }));
+  // The snapshot list names every snapshot of the run, in order, up to the checkpoint's time: an
+  // empty or shortened list would make the resumed run overwrite snapshot_00000.vtp.
+  refused(edited([](auto& j) { j["snapshots"] = nlohmann::json::array(); }), "\"snapshots\" is empty");
+  refused(edited([](auto& j) { j["snapshots"].erase(j["snapshots"].size() - 1); }), "\"time\"");
+  refused(edited([](auto& j) { j["snapshots"][0][1] = "snapshot_00001.vtp"; }), "expected 'snapshot_00000.vtp'");
+  // A list two shorter, its time and steps edited to match: snapshot files beyond it are present.
+  refused(edited([](auto& j) {
+            j["snapshots"].erase(j["snapshots"].size() - 1);
+            j["snapshots"].erase(j["snapshots"].size() - 1);
+            j["time"] = j["snapshots"].back()[0];
+          }),
+          "would overwrite");
+  // A checkpoint names no file of the run as a side file to delete.
+  refused(edited([](auto& j) { j["side_files"] = {"timeseries.csv"}; }), "\"side_files\" names 'timeseries.csv'");
+  // The proposed step: none before the first step, and no larger than the controller proposes.
+  refused(edited([](auto& j) { j["solver_state"]["dt_next"] = 0; }), "dt_next");
+  refused(edited([](auto& j) { j["solver_state"]["dt_next"] = 1e308; }), "dt_next");
+  // "time" and "steps" against the rows of timeseries.csv.
+  const double t = nlohmann::json::parse(good).at("time").get<double>();
+  refused(edited([&](auto& j) { j["time"] = t + 0.01; j["snapshots"].back()[0] = t + 0.01; }), "row");
+  refused(edited([](auto& j) { j["steps"] = j["steps"].template get<int>() - 2; }), "row");
+  EXPECT_EQ(slurp(dir / "run" / "snapshot_00000.vtp").empty(), false);
+  EXPECT_EQ(n, s->membrane().num_vertices());
+}
+
+TEST_F(CapsuleRun, KeptRowsOfTheTimeSeriesAreParsedAndCrossChecked) {
+  auto s = solver();
+  const fs::path run = dir / "run";
+  ASSERT_TRUE(run_capsule(*s, options(run, 0.15)).finished);
+  const fs::path series = run / "timeseries.csv";
+  const std::string good = slurp(series), checkpoint = slurp(run / "checkpoint.json");
+  const std::size_t second = good.find('\n', good.find('\n') + 1) + 1;  // the start of row 2 (line 3)
+  auto refused = [&](const std::string& text, const std::string& expected) {
+    spit(series, text);
+    auto fresh = solver();
+    CapsuleRunOptions o = options(run, 0.2);
+    o.resume = true;
+    try {
+      run_capsule(*fresh, o);
+      ADD_FAILURE() << "accepted a time series that should name " << expected;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(slurp(series), text);  // refused before any change
+    EXPECT_EQ(slurp(run / "checkpoint.json"), checkpoint);
+  };
+  refused(good.substr(0, second) + "garbage\n" + good.substr(good.find('\n', second) + 1), "line 3: 'garbage'");
+  refused(good.substr(0, second) + "0.1,0.2,0.3,4,12,nan,0.001\n" + good.substr(good.find('\n', second) + 1),
+          "line 3: 7 columns");
+  refused(good.substr(0, second) + "0.1,0.2,0.3,4,12,nan,0.001,-0.01\n" + good.substr(good.find('\n', second) + 1),
+          "line 3");
+  // A folder in place of the file is named as such, not as an empty header.
+  fs::remove(series);
+  fs::create_directory(series);
+  {
+    auto fresh = solver();
+    CapsuleRunOptions o = options(run, 0.2);
+    o.resume = true;
+    try {
+      run_capsule(*fresh, o);
+      ADD_FAILURE() << "accepted a folder as the time series";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("a folder"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("timeseries.csv"), std::string::npos) << e.what();
+    }
+  }
+  fs::remove(series);
+  spit(series, good);
   auto fresh = solver();
-  CapsuleRunOptions r = o;
-  r.resume = true;
-  r.t_end = 0.2;
-  EXPECT_TRUE(run_capsule(*fresh, r).finished);
-  EXPECT_EQ(n, fresh->membrane().num_vertices());
+  CapsuleRunOptions o = options(run, 0.2);
+  o.resume = true;
+  EXPECT_TRUE(run_capsule(*fresh, o).finished);
+}
+
+TEST_F(CapsuleRun, ASecondRunIntoALockedFolderIsRefused) {
+  const fs::path run = dir / "run";
+  fs::create_directories(run);
+  // Another process's lock, held here (flock locks conflict between open files, even in one process).
+  FolderLock held(run, "run folder");
+  auto s = solver();
+  try {
+    run_capsule(*s, options(run, 0.05));
+    ADD_FAILURE() << "a second run into a locked folder was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("in use by another run"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(run / "timeseries.csv"));
+}
+
+TEST_F(CapsuleRun, ANewRunIntoAFolderHoldingARunNeedsOverwrite) {
+  const fs::path run = dir / "run";
+  auto s = solver();
+  ASSERT_TRUE(run_capsule(*s, options(run, 0.3)).finished);
+  ASSERT_TRUE(fs::exists(run / "snapshot_00003.vtp"));
+  EXPECT_FALSE(fs::exists(run / ".lock"));  // released with the run
+  spit(run / "notes.txt", "mine");
+  const std::string series = slurp(run / "timeseries.csv"), summary = slurp(run / "summary.json");
+  auto again = solver();
+  try {
+    run_capsule(*again, options(run, 0.1));
+    ADD_FAILURE() << "a new run replaced another run without overwrite";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("holds another run"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(slurp(run / "timeseries.csv"), series);
+  EXPECT_EQ(slurp(run / "summary.json"), summary);
+  // With overwrite the old run's files go (its later snapshots too); other files stay.
+  CapsuleRunOptions o = options(run, 0.1);
+  o.overwrite = true;
+  auto third = solver();
+  ASSERT_TRUE(run_capsule(*third, o).finished);
+  EXPECT_TRUE(fs::exists(run / "snapshot_00001.vtp"));
+  EXPECT_FALSE(fs::exists(run / "snapshot_00002.vtp"));
+  EXPECT_FALSE(fs::exists(run / "snapshot_00003.vtp"));
+  EXPECT_EQ(slurp(run / "notes.txt"), "mine");
+}
+
+TEST_F(CapsuleRun, ResumeRemovesTheRunsStaleTemporariesOnly) {
+  const fs::path run = dir / "run";
+  auto s = solver();
+  CapsuleRunOptions o = options(run, 0.3);
+  o.stop_after_steps = 3;
+  ASSERT_FALSE(run_capsule(*s, o).finished);
+  // What a kill during writes leaves, and a file of someone else's.
+  for (const char* f : {"snapshot_00001.vtp.tmpAb3dEf", "timeseries.csv.tmp4242", "checkpoint.json.tmpZZZZZZ"})
+    spit(run / f, "half");
+  spit(run / "mine.tmp", "keep");
+  auto again = solver();
+  o.stop_after_steps = 0;
+  o.resume = true;
+  ASSERT_TRUE(run_capsule(*again, o).finished);
+  for (const auto& e : fs::directory_iterator(run))
+    EXPECT_TRUE(e.path().filename() == "mine.tmp" || e.path().filename().string().find(".tmp") == std::string::npos)
+        << e.path();
+  EXPECT_EQ(slurp(run / "mine.tmp"), "keep");
+}
+
+TEST_F(CapsuleRun, AFolderWhoseParentIsMissingIsRefused) {
+  auto s = solver();
+  try {
+    run_capsule(*s, options(dir / "a" / "b" / "c", 0.05));
+    ADD_FAILURE() << "created missing parents";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("does not exist"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(dir / "a"));
 }
 
 TEST_F(CapsuleRun, FailedSnapshotWriteEndsTheRunAndKeepsTheCheckpoint) {
@@ -290,6 +429,7 @@ TEST_F(CapsuleRun, ManyRunsInOneProcess) {
     auto s = solver(1);
     CapsuleRunOptions o = options(dir / ("run" + std::to_string(k % 3)), 0.002);
     o.snapshot_every = 0.001;
+    o.overwrite = true;
     int progress = 0;
     o.on_progress = [&](const CapsuleProgress&) { ++progress; };
     const CapsuleRunResult r = run_capsule(*s, o);

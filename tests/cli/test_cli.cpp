@@ -4,6 +4,9 @@
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <spawn.h>
+#include <sys/file.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -557,4 +560,106 @@ TEST_F(Cli, ShearSkalakLawIsRecordedAndPartOfTheRunsIdentity) {
   expect_refused(run("shear --membrane neo-hookean --skalak-c 2" + common + (dir / "bad").string()), "--skalak-c",
                  dir / "bad");
   expect_refused(run("shear --membrane mooney" + common + (dir / "bad").string()), "--membrane", dir / "bad");
+}
+
+// Issue 29: nothing lost, nothing trusted blindly.
+
+TEST_F(Cli, EmptyNumbersAndRingsOutOfRangeAreRefused) {
+  const fs::path mesh = dir / "s.off", out = dir / "o.csv", run_dir = dir / "run";
+  ASSERT_EQ(run("mesh --family mt1 --level 1 --out " + mesh.string()).status, 0);
+  expect_refused(run({"mesh", "--level", "", "--out", (dir / "m.off").string()}), "'' is not a number",
+                 dir / "m.off");
+  expect_refused(run({"shear", "--method", "C", "--kappa-b-hat", "", "--out", run_dir.string()}),
+                 "'' is not a number", run_dir);
+  expect_refused(run({"shear", "--membrane", "skalak", "--skalak-c", "", "--out", run_dir.string()}),
+                 "'' is not a number", run_dir);
+  expect_refused(run({"forces", "--mesh", mesh.string(), "--method", "C", "--kappa-b", "", "--out", out.string()}),
+                 "'' is not a number", out);
+  expect_refused(run({"shape", "--mesh", mesh.string(), "--shape", "sphere", "--kappa-b", "", "--out", out.string()}),
+                 "'' is not a number", out);
+  const fs::path rbc = dir / "rbc";
+  expect_refused(run({"rbc", "--rings", "0", "--no-plots", "--out", rbc.string()}), "--rings", rbc);
+  expect_refused(run({"rbc", "--rings", "", "--no-plots", "--out", rbc.string()}), "--rings", rbc);
+}
+
+TEST_F(Cli, ShearRefusesAFolderWhoseParentIsMissing) {
+  const fs::path out = dir / "a" / "b" / "c";
+  expect_refused(run("shear --mesh mt1:320 --t-end 0.01 --no-plot --out " + out.string()), "does not exist", out);
+  EXPECT_FALSE(fs::exists(dir / "a"));
+}
+
+TEST_F(Cli, ShearRefusesASecondRunIntoALockedFolder) {
+  // The first run's lock, held by this process: the second run is refused at once, deterministically.
+  const fs::path out = dir / "run";
+  fs::create_directories(out);
+  const int fd = ::open((out / ".lock").c_str(), O_RDWR | O_CREAT, 0644);
+  ASSERT_GE(fd, 0);
+  ASSERT_EQ(::flock(fd, LOCK_EX | LOCK_NB), 0);
+  const CliRun r = run("shear --mesh mt1:320 --G 0.2 --t-end 0.01 --no-plot --out " + out.string());
+  ::close(fd);
+  expect_refused(r, "in use by another run", out / "timeseries.csv");
+}
+
+TEST_F(Cli, ShearNeedsOverwriteToReplaceAnotherRun) {
+  const fs::path out = dir / "run";
+  const std::string args = "shear --mesh mt1:320 --t-end 0.02 --snapshot-every 0.005 --no-plot --out " + out.string();
+  ASSERT_EQ(run(args + " --G 0.1").status, 0);
+  const std::string series = slurp(out / "timeseries.csv");
+  const CliRun refused = run(args + " --G 0.2");
+  EXPECT_EQ(refused.status, 1);
+  EXPECT_NE(refused.err.find("--overwrite"), std::string::npos) << refused.err;
+  EXPECT_EQ(slurp(out / "timeseries.csv"), series);
+  // --overwrite replaces it, and leaves none of the old run's snapshots beside the new.
+  const CliRun r = run("shear --mesh mt1:320 --t-end 0.01 --snapshot-every 0.005 --no-plot --G 0.2 --overwrite --out " +
+                       out.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(slurp(out / "timeseries.csv"), series);
+  EXPECT_TRUE(fs::exists(out / "snapshot_00002.vtp"));
+  EXPECT_FALSE(fs::exists(out / "snapshot_00003.vtp"));
+  expect_refused(run("shear --mesh mt1:320 --t-end 0.03 --snapshot-every 0.005 --no-plot --G 0.2 --resume --overwrite "
+                     "--out " + out.string()),
+                 "excludes", out / "nothing");
+}
+
+TEST_F(Cli, ShearResumeRefusesACheckpointThatIsNotARegularFile) {
+  const fs::path out = dir / "run";
+  fs::create_directories(out);
+  ASSERT_EQ(::mkfifo((out / "checkpoint.json").c_str(), 0644), 0);
+  // A FIFO is refused at once (reading it would wait for a writer forever).
+  CliRun r = run("shear --mesh mt1:320 --t-end 0.01 --no-plot --resume --out " + out.string());
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("FIFO"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("checkpoint.json"), std::string::npos) << r.err;
+  fs::remove(out / "checkpoint.json");
+  fs::create_directory(out / "checkpoint.json");
+  r = run("shear --mesh mt1:320 --t-end 0.01 --no-plot --resume --out " + out.string());
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("a folder"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("checkpoint.json"), std::string::npos) << r.err;
+}
+
+TEST_F(Cli, AWriteBeyondTheFileSizeLimitIsAnErrorAndLeavesNoTemporary) {
+  // ulimit -f: the write fails (EFBIG) instead of SIGXFSZ killing bendlab mid-write.
+  struct rlimit old {};
+  ASSERT_EQ(::getrlimit(RLIMIT_FSIZE, &old), 0);
+  struct rlimit small = old;
+  small.rlim_cur = 64 * 1024;
+  ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &small), 0);
+  const fs::path out = dir / "m.vtp";
+  const CliRun r = run("mesh --family mt1 --level 5 --out " + out.string());
+  ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &old), 0);
+  expect_refused(r, "error while writing", out);
+  EXPECT_NE(r.err.find("m.vtp"), std::string::npos) << r.err;
+}
+
+TEST_F(Cli, TwoDisjointSurfacesAreRefused) {
+  // Two tetrahedra: each closed and outward, together not one surface.
+  const std::string second = "5 5 5\n6 5 5\n5 6 5\n5 5 6\n";
+  const std::string faces2 = "3 4 6 5\n3 4 5 7\n3 4 7 6\n3 5 6 7\n";
+  write(dir / "two.off", off(kTetraVertices + second, kTetraFaces + faces2, 8, 8));
+  const fs::path out = dir / "f.csv";
+  expect_refused(run("forces --mesh " + (dir / "two.off").string() + " --method C --out " + out.string()),
+                 "several components", out);
+  expect_refused(run("shear --mesh " + (dir / "two.off").string() + " --out " + (dir / "run").string()),
+                 "several components", dir / "run");
 }

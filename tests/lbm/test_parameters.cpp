@@ -72,3 +72,22 @@ TEST(CapsuleRunParameters, WarnsAboveThePapersReynoldsNumber) {
   ASSERT_FALSE(p.warnings.empty());
   EXPECT_NE(p.warnings.front().find("Reynolds"), std::string::npos);
 }
+
+TEST(CapsuleRunParameters, AHugeRadiusIsRefusedWithoutOverflow) {
+  CapsuleRunInput in;
+  in.radius = 1e9;  // 9.5e9 nodes along x: beyond an int
+  const std::string e = error_of(in);
+  EXPECT_NE(e.find("box x"), std::string::npos) << e;
+  EXPECT_NE(e.find("lower the radius"), std::string::npos) << e;
+  EXPECT_EQ(e.find("-"), std::string::npos) << e;  // no negative node count
+}
+
+TEST(CapsuleRunParameters, WarnsWhenTauNearAHalfMakesTheRunLong) {
+  CapsuleRunInput in;
+  in.tau = 0.500001;
+  in.gamma_t_end = 0.01;
+  const CapsuleRunParameters p = capsule_run_parameters(in);
+  ASSERT_FALSE(p.warnings.empty());
+  EXPECT_NE(p.warnings.front().find(std::to_string(p.steps) + " lattice steps"), std::string::npos)
+      << p.warnings.front();
+}

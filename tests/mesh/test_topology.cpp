@@ -140,3 +140,22 @@ TEST(MeshValidation, FlipOptionReversesInwardFaces) {
   TriMesh m(tetra_points(), f, MeshOptions{true});
   EXPECT_EQ(m.faces().row(0), tetra_faces().row(0));
 }
+
+TEST(MeshValidation, RefusesMoreThanOneComponent) {
+  // Two disjoint tetrahedra: each closed and outward, together not one surface (a capsule's
+  // shape measures of them would describe no body).
+  Points p(8, 3);
+  p.topRows(4) = tetra_points();
+  p.bottomRows(4) = tetra_points().array() + 5.0;
+  Faces f(8, 3);
+  f.topRows(4) = tetra_faces();
+  f.bottomRows(4) = tetra_faces().array() + 4;
+  try {
+    TriMesh m(p, f);
+    FAIL() << "two components were accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("several components: the mesh has 2 connected components"),
+              std::string::npos)
+        << e.what();
+  }
+}

@@ -17,6 +17,15 @@
 //
 // Every write is checked: a failed write throws bendlab::Error naming the file, and the last
 // complete checkpoint stays in place. Nothing here prints: progress and notes go to callbacks.
+//
+// The folder is locked (core/folder_lock.hpp) while a run owns it: a second run into it is
+// refused at once. A new run into a folder holding another run is refused unless
+// options.overwrite. A resume trusts nothing it reads back: the checkpoint's snapshot list must
+// name snapshot_00000.vtp, snapshot_00001.vtp, ... up to the checkpoint's time, all present; its
+// side files must be the solver's own names; the kept rows of timeseries.csv are parsed like new
+// ones, their steps must be positive and add up to their times, and the last must be at the
+// checkpoint's time (so "steps" equals the row count). Temporary files an interrupted write left
+// in the folder are removed.
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -40,10 +49,13 @@ struct CapsuleProgress {
 };
 
 struct CapsuleRunOptions {
-  std::filesystem::path folder;  ///< run folder (created if missing)
+  std::filesystem::path folder;  ///< run folder (created if missing; its parent must exist)
   double t_end = 10;             ///< gamma t
   double snapshot_every = 0.5;   ///< gamma t between snapshots and checkpoints
   bool resume = false;           ///< continue from folder/checkpoint.json
+  /// A new run (not resume) into a folder that holds files of another run: false refuses it,
+  /// true removes that run's files (run_file_name) first. Files of other names are never touched.
+  bool overwrite = false;
   /// The run's identity: must be equal (numbers to 1e-12 relative) when resuming; copied into
   /// checkpoint.json and summary.json.
   nlohmann::json arguments = nlohmann::json::object();
@@ -78,6 +90,10 @@ TimeSeriesRow capsule_sample(const MembraneModel& membrane, const Points& x, dou
 /// Runs `solver` as described above. Throws bendlab::Error (before any file changes for bad
 /// options or a refused checkpoint).
 CapsuleRunResult run_capsule(CapsuleSolver& solver, const CapsuleRunOptions& options);
+
+/// Whether `name` is a file a capsule run writes into its folder (with `solver`'s side files), or
+/// a temporary of one: the files --overwrite removes.
+bool is_run_file(const std::string& name, const CapsuleSolver& solver);
 
 /// Whether two argument sets are equal (same keys; numbers to 1e-12 relative); otherwise the first
 /// difference in words ("G is 0.2 here but 0.1 in the checkpoint").

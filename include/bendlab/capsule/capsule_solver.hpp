@@ -75,6 +75,19 @@ class CapsuleSolver {
   virtual void restore_state(const Points& positions, double time, const SolverCounters& counters,
                              const nlohmann::json& fields, const std::filesystem::path& folder,
                              const std::string& source) = 0;
+  /// Whether `name` is a side file this solver writes (save_state): a checkpoint naming any other
+  /// file is refused, and the run deletes no file of another name.
+  virtual bool is_side_file(const std::string& name) const {
+    (void)name;
+    return false;
+  }
+  /// Called after restore_state on a resume with the largest step of the kept time-series rows
+  /// (0 when none): throws bendlab::Error naming `source` if the restored state is inconsistent
+  /// with the steps taken (e.g. a proposed step no controller would have proposed).
+  virtual void check_resumed_steps(double largest_step, const std::string& source) const {
+    (void)largest_step;
+    (void)source;
+  }
 };
 
 }  // namespace bendlab

@@ -32,14 +32,20 @@ std::vector<TimeSeriesRow> read_time_series(const std::filesystem::path& path);
 /// The rows of the text of a time series file (what read_time_series() does after reading it);
 /// `source` names it in errors. Throws bendlab::Error, and nothing else, for any malformed text.
 std::vector<TimeSeriesRow> parse_time_series(const std::string& text, const std::string& source);
+/// The first `rows` rows of the time series file at path, parsed as read_time_series parses every
+/// row (the rows after them are not read: a killed run may have left half a row there). Throws
+/// bendlab::Error naming the file and line for anything but a regular file, a wrong header, a
+/// malformed row or fewer complete rows. `bytes`, if given, receives the length of the header and
+/// those rows in the file.
+std::vector<TimeSeriesRow> read_time_series_head(const std::filesystem::path& path, std::int64_t rows,
+                                                 std::size_t* bytes = nullptr);
 
 class TimeSeriesFile {
  public:
   /// A new file holding only the header (replacing any file at path, atomically).
   static TimeSeriesFile create(const std::filesystem::path& path);
   /// Keeps the header and the first `rows` rows of an existing file, byte for byte (atomic
-  /// rewrite), then appends after them. Throws if the file is missing, its header differs or it
-  /// has fewer rows.
+  /// rewrite), then appends after them. Throws, before any change, as read_time_series_head does.
   static TimeSeriesFile resume(const std::filesystem::path& path, std::int64_t rows);
   /// Appends to path as it is (no header check); for tests of failing devices.
   static TimeSeriesFile append_to(const std::filesystem::path& path, std::int64_t rows = 0);

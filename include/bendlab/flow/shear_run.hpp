@@ -33,7 +33,7 @@ struct LatticeRunSpec {
 };
 
 struct ShearRunSpec {
-  std::filesystem::path folder;        ///< run folder (created if missing)
+  std::filesystem::path folder;        ///< run folder (created if missing; its parent must exist)
   std::string solver = "bim";          ///< flow solver: "bim" or "lbm"
   LatticeRunSpec lattice;              ///< used by "lbm"
   std::string method = "none";         ///< bending method (registry name) or "none"
@@ -50,6 +50,7 @@ struct ShearRunSpec {
   std::string bim_quadrature = "all7";  ///< the BIM single layer's regular quadrature: "all7" (reference), "adaptive", "tree" or "tree-mixed" (stokes_single_layer.hpp)
   double rtol = 1e-7, atol = 1e-6;     ///< the BIM integrator's tolerances (atol in units of R)
   bool resume = false;                 ///< continue from folder/checkpoint.json
+  bool overwrite = false;              ///< a new run may replace another run's files in folder (CapsuleRunOptions)
   std::int64_t stop_after_steps = 0;   ///< stop (resumable) after this many steps; 0: never
 };
 

@@ -48,6 +48,7 @@ class CashKarp final : public Integrator {
   /// The step the controller will try next; inside on_accept, the proposal after that step
   /// (what a checkpoint should store to resume the integration as it would have gone on).
   double proposed_step() const override { return proposed_; }
+  double max_step_growth() const override { return options_.grow; }
   const IntegratorStats& stats() const override { return stats_; }
 
  private:

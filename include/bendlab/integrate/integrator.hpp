@@ -49,6 +49,9 @@ class Integrator {
   /// The step the controller will try next; inside on_accept, the proposal after that step (what a
   /// checkpoint stores to resume the integration as it would have gone on).
   virtual double proposed_step() const = 0;
+  /// The largest factor between a step and the step proposed after it (a resumed run checks a
+  /// checkpoint's proposed step against the steps taken).
+  virtual double max_step_growth() const = 0;
   /// The counts of the integration in progress (valid inside on_accept) or of the last one.
   virtual const IntegratorStats& stats() const = 0;
   /// The state beyond proposed_step() that an identical resume needs (controller memory and the

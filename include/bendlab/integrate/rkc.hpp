@@ -122,6 +122,7 @@ class Rkc final : public Integrator {
   IntegratorStats integrate(const Rhs& rhs, double t0, double t1, State& y, double dt0 = 0,
                             const OnAccept& on_accept = {}) override;
   double proposed_step() const override { return proposed_; }
+  double max_step_growth() const override { return options_.grow; }
   std::string name() const override { return "rkc"; }
 
   /// The statistics of the current (inside on_accept) or last integration, with the RKC fields.

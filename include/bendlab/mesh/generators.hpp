@@ -52,7 +52,14 @@ TriMesh rivara_pass(const TriMesh& mesh, bool project_to_unit_sphere = true);
 /// (20 * 4^k or 8 * 4^k), or -1 if there is none.
 int level_with_triangles(MeshFamily family, long triangles);
 
-/// The unit sphere of a family at refinement level k, then `rivara_passes` Rivara passes.
+/// The limits of sphere_mesh (level 0..8: 1.3 million triangles of MT1; 0..6 Rivara passes), for
+/// every caller alike (the command line, the Python module): throws bendlab::Error naming the
+/// argument by `level_name` or `rivara_name`.
+void check_sphere_mesh_arguments(int level, int rivara_passes, const std::string& level_name = "level",
+                                 const std::string& rivara_name = "rivara_passes");
+
+/// The unit sphere of a family at refinement level k, then `rivara_passes` Rivara passes
+/// (check_sphere_mesh_arguments first).
 TriMesh sphere_mesh(MeshFamily family, int level, int rivara_passes = 0);
 
 }  // namespace bendlab

@@ -120,6 +120,21 @@ SolverState BimCapsuleSolver::save_state(const std::filesystem::path&, const std
   return s;
 }
 
+void BimCapsuleSolver::check_resumed_steps(double largest_step, const std::string& source) const {
+  if (largest_step <= 0) {
+    if (dt_next_ != 0)
+      throw Error(fmt::format("{}: \"solver_state\": \"dt_next\" is {} but the run has taken no step (expected 0)",
+                              source, dt_next_));
+    return;
+  }
+  // 1e-5: the time series keeps a step to 6 digits.
+  const double largest = integrator_->max_step_growth() * largest_step * (1 + 1e-5);
+  if (!(dt_next_ > 0) || dt_next_ > largest)
+    throw Error(fmt::format("{}: \"solver_state\": \"dt_next\" is {}, expected a step in (0, {:.6g}] ({} times the "
+                            "largest step of the time series, {:.6g})",
+                            source, dt_next_, largest, integrator_->max_step_growth(), largest_step));
+}
+
 nlohmann::json BimCapsuleSolver::summary() const {
   nlohmann::json j = {{"integrator", integrator_->name()}};
   nlohmann::json stats = integrator_->summary();

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <regex>
 
 #include "bendlab/geometry/measures.hpp"
 
@@ -90,6 +91,11 @@ bool IbCapsuleSolver::advance(double t_end, const OnStep& on_step) {
   return true;
 }
 
+bool IbCapsuleSolver::is_side_file(const std::string& name) const {
+  static const std::regex fluid_re(R"(lbm_fluid_\d{5,}\.bin)");
+  return std::regex_match(name, fluid_re);
+}
+
 SolverState IbCapsuleSolver::save_state(const std::filesystem::path& folder, const std::string& tag) const {
   check_fluid();  // never checkpoint a broken fluid
   SolverState s;
@@ -108,6 +114,8 @@ void IbCapsuleSolver::restore_state(const Points& positions, double time, const 
   auto bad = [&](const std::string& what) { return Error(fmt::format("{}: \"solver_state\": {}", source, what)); };
   if (!fields.is_object()) throw bad("must be an object");
   if (!fields.contains("fluid") || !fields.at("fluid").is_string()) throw bad("\"fluid\" must name the fluid file");
+  if (!is_side_file(fields.at("fluid").get<std::string>()))
+    throw bad(fmt::format("\"fluid\" is {}, expected lbm_fluid_NNNNN.bin", fields.at("fluid").dump()));
   if (!fields.contains("lattice_step") || !fields.at("lattice_step").is_number_integer() ||
       fields.at("lattice_step").get<std::int64_t>() < 0)
     throw bad("\"lattice_step\" must be an integer >= 0");

@@ -30,7 +30,14 @@ CapsuleRunParameters capsule_run_parameters(const CapsuleRunInput& in) {
   CapsuleRunParameters p;
   auto nodes = [&](double multiple, const char* axis) {
     if (!(multiple > 0) || !std::isfinite(multiple)) throw Error(fmt::format("box {} = {} R must be positive", axis, multiple));
-    return static_cast<int>(std::lround(multiple * R));
+    // Counted in double first: an int would overflow (and name a negative box) for a huge R.
+    constexpr double kMaxNodes = 100000;
+    const double n = std::round(multiple * R);
+    if (n > kMaxNodes)
+      throw Error(fmt::format("box {} = {} R of R = {} lattice units is {:.4g} nodes, more than the {:.0f} a lattice "
+                              "takes along an axis (lower the radius in lattice units)",
+                              axis, multiple, R, n, kMaxNodes));
+    return static_cast<int>(n);
   };
   p.nx = nodes(in.box_x, "x");
   p.ny = nodes(in.box_y, "y");
@@ -62,6 +69,14 @@ CapsuleRunParameters capsule_run_parameters(const CapsuleRunInput& in) {
   if (in.reynolds > 0.3) {
     p.warnings.push_back(fmt::format("Reynolds number Re = R v / nu = {} is above the paper's bound 0.3", in.reynolds));
   }
+  // tau near 1/2 makes nu and the wall speed, so the shear rate per lattice step, tiny: say what
+  // the run will cost before it starts.
+  constexpr double kManySteps = 1e7;
+  if (static_cast<double>(p.steps) > kManySteps)
+    p.warnings.push_back(fmt::format("the run takes {} lattice steps of {:.3g} nodes each to gamma t = {} (tau = {} "
+                                     "makes the shear rate {:.3g} per step); expect a long run",
+                                     p.steps, static_cast<double>(p.nx) * p.ny * p.nz, in.gamma_t_end, in.tau,
+                                     p.shear_rate));
   if (p.mach > 0.01) p.warnings.push_back(fmt::format("wall Mach number {:.3g} is above the paper's 0.01", p.mach));
   return p;
 }

@@ -51,6 +51,9 @@ class BimCapsuleSolver final : public CapsuleSolver {
   void restore_state(const Points& positions, double time, const SolverCounters& counters,
                      const nlohmann::json& fields, const std::filesystem::path& folder,
                      const std::string& source) override;
+  /// dt_next must be 0 before the first step and, after it, positive and at most the integrator's
+  /// growth factor times the largest step taken.
+  void check_resumed_steps(double largest_step, const std::string& source) const override;
 
   /// Sets positions (same topology), time and the step to try first (0: the integrator's default).
   void restart(const Points& positions, double time, double dt_next = 0);

@@ -67,6 +67,8 @@ class IbCapsuleSolver : public CapsuleSolver {
   void restore_state(const Points& positions, double time, const SolverCounters& counters,
                      const nlohmann::json& fields, const std::filesystem::path& folder,
                      const std::string& source) override;
+  /// lbm_fluid_NNNNN.bin, the fluid of a checkpoint.
+  bool is_side_file(const std::string& name) const override;
 
   /// One lattice step (steps 1-4 above) without reporting; throws on blow-up.
   void step();
