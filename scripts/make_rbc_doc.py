@@ -80,6 +80,7 @@ METHOD_S_EXPECTED = {
     5120: {"n": (1.0e-3, 8.7e-5), "H": (5.0e-2, 2.6e-3), "K": (0.19, 3.8e-3), "f": (1.7, 0.060), "E": 48.4742},
     20480: {"n": (4.7e-4, 1.1e-5), "H": (4.9e-2, 7.2e-4), "K": (0.19, 1.1e-3), "f": (8.5, 0.072), "E": 48.4736},
 }
+DEFAULT_JITTER, DEFAULT_JITTER_SEED = 0.25, 28  # bendlab rbc's --jitter and --jitter-seed defaults
 COPIED = ["errors.csv", "timings.csv", "errors.json", "table2.md", "table3.md"]
 
 
@@ -276,6 +277,41 @@ def extra_section(study, methods):
     return md
 
 
+def jitter_args(opts):
+    """The --jitter and --jitter-seed of a study that ran the irregular family with other than the defaults."""
+    if "irregular" not in opts["families"]:
+        return ""
+    out = ""
+    if opts.get("jitter", DEFAULT_JITTER) != DEFAULT_JITTER:
+        out += f" --jitter {opts['jitter']}"
+    if opts.get("jitter_seed", DEFAULT_JITTER_SEED) != DEFAULT_JITTER_SEED:
+        out += f" --jitter-seed {opts['jitter_seed']}"
+    return out
+
+
+def irregular_section(study, study_dir, extra_dir, extra_methods):
+    """Table 2's symbols on the irregular family beside MT1's, from table2.md of the studies."""
+    opts = study["options"]
+    md = ["## The irregular family (beyond the paper)\n"]
+    md.append(f"MT1 with every node moved in its tangent plane by {opts.get('jitter', DEFAULT_JITTER)} times the mean "
+              "length of its edges, in a direction drawn uniformly from std::mt19937_64 seeded with "
+              f"{opts.get('jitter_seed', DEFAULT_JITTER_SEED)} + level, and projected back onto the sphere before "
+              "the map to the RBC (docs/conventions.md §4). Unlike the Rivara meshes, every level is jittered "
+              "afresh, so the meshes stay irregular under refinement: this is where a method's errors show "
+              "whether it needs the regularity that MT1 and MT2 gain as they are refined. Cells: symbol (s_tail), "
+              "as in table 2; the MT1 table above is the same meshes before the jitter.\n")
+    for folder, label in ((study_dir, ""), (extra_dir, f" (Method(s) {', '.join(extra_methods)})")):
+        if not folder:
+            continue
+        with open(os.path.join(folder, "table2.md")) as f:
+            t2 = f.read()
+        for part in t2.split("\n## ")[1:]:
+            head, _, body = part.partition("\n")
+            if head.startswith("irregular"):
+                md.append(f"#### {head}{label}\n" + body.strip() + "\n")
+    return md
+
+
 def main():
     args = sys.argv[1:]
     command = None
@@ -332,13 +368,15 @@ def main():
         command = (f"build/release/bendlab rbc --max-triangles {opts['max_triangles']} "
                    f"--families {','.join(opts['families'])} --methods {','.join(main_methods)}"
                    + (f" --rings {opts['rings']}" if opts.get("rings") else "")
+                   + jitter_args(opts)
                    + f" --out {study_dir} && /usr/bin/python3 scripts/make_rbc_doc.py {study_dir}"
                    + (f" --polar {polar_dir}" if polar_dir else "")
                    + (f" --extra {extra_dir}" if extra_dir else ""))
         if extra_dir:
             eo = extra["options"]
             command = (f"build/release/bendlab rbc --max-triangles {eo['max_triangles']} --families "
-                       f"{','.join(eo['families'])} --methods {','.join(eo['methods'])} --out {extra_dir} && " + command)
+                       f"{','.join(eo['families'])} --methods {','.join(eo['methods'])}{jitter_args(eo)} "
+                       f"--out {extra_dir} && " + command)
         if polar_dir:
             command = polar["command"] + " && " + command
     md = []
@@ -356,7 +394,9 @@ def main():
                        [[x["family"], str(x["level"]) + (" + 3 Rivara" if x["inhomogeneous"] else ""),
                          str(x["triangles"]), str(x["vertices"]), f"{x['h']:.5f}"] for x in study["meshes"]]))
     md.append("\nThe inhomogeneous meshes are the 320-triangle spheres after three passes of Rivara's bisection; "
-              "the paper reports 3914 (MT1) and 3848 (MT2) triangles, tie-breaking changes the count.\n")
+              "the paper reports 3914 (MT1) and 3848 (MT2) triangles, tie-breaking changes the count. The "
+              "irregular meshes (not in the paper) are the MT1 spheres with every node jittered; see the section "
+              "on them below.\n")
 
     md.append("## Table 2: convergence\n")
     md.append(f"Symbols from the least-squares slope s of log(error) against log(1/h) on the finest meshes "
@@ -392,6 +432,9 @@ def main():
             if head.startswith("mt1"):
                 md.append(f"#### {head} (Method(s) {', '.join(extra_methods)})\n" + body.strip() + "\n")
 
+    if any(m["family"] == "irregular" for m in study["meshes"]):
+        md += irregular_section(study, study_dir, extra_dir, extra_methods)
+
     md.append("## Table 3: the inhomogeneous mesh\n")
     beyond = [m for m in study["options"]["methods"] if m in NOT_IN_PAPER]
     if beyond:
@@ -420,14 +463,14 @@ def main():
     md.append("## Plots\n")
     md.append("Errors against 1/h with guide slopes h^1, h^2, h^-1, h^-2 (figures 3, 5, 7, 10 and, for MT2, "
               "B.19-B.21, B.23); stars with a tick: the inhomogeneous mesh; open markers: the octahedron meshes "
-              "(512, 2048 triangles). Then the values against the polar angle theta (eq. 16) with the exact curve "
+              "(512, 2048 triangles) on the MT1 plots and the MT1 meshes on the irregular family's. Then the values against the polar angle theta (eq. 16) with the exact curve "
               "(figures 4, 6, 8). Per-node errors for figure 9 / B.22 are in the .vtp files of the study folder "
               "(errors_<family>_5120_<method>.vtp, fields eps_n, eps_H, eps_K, eps_lapH, eps_f).\n")
-    for fam in ("mt1", "mt2"):
+    for fam in ("mt1", "mt2", "irregular"):
         for q in ("n", "H", "K", "lapH", "f"):
             name = f"errors_{q}_{fam}.png"
             if name in pngs:
-                md.append(f"![{QUANTITY_NAMES[q]} errors, {fam.upper()}](rbc/{name})\n")
+                md.append(f"![{QUANTITY_NAMES[q]} errors, {fam if fam == 'irregular' else fam.upper()}](rbc/{name})\n")
     for name in pngs:
         if name.startswith("values_"):
             md.append(f"![{name[:-4]}](rbc/{name})\n")

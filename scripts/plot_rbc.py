@@ -7,7 +7,8 @@ Reads DIR/errors.csv and DIR/values_<family>_<triangles>.csv; writes into DIR
   errors_<quantity>_<family>.png   maximal and average error against 1/h, with guide slopes
                                    h^1, h^2, h^-1, h^-2 (figures 3, 5, 7, 10; MT2: B.19-B.23);
                                    the inhomogeneous mesh of the family is the star with a tick,
-                                   the octahedron meshes (MT1 plots) the open markers.
+                                   the open markers are the octahedron meshes (MT1 plots) or the
+                                   MT1 meshes the irregular family jitters (irregular plots).
   values_<quantity>_<family>_<N>.png  numerical values against the polar angle theta, one panel
                                    per method, with the exact curve (figures 4, 6, 8), at the
                                    finest mesh up to 5120 triangles.
@@ -33,6 +34,9 @@ QUANTITIES = {
 }
 VALUE_COLUMNS = {"H": ("H", "H_exact", "$H$"), "lapH": ("lapH", "lapH_exact", "$\\Delta_S H$"),
                  "f": ("f_abs", "f_abs_exact", "$|\\mathbf{f}|$")}
+PLOTTED_FAMILIES = ("mt1", "mt2", "irregular")
+# The family drawn with open markers beside a family, and how the plot's title names it.
+COMPANION = {"mt1": ("octa", "octahedron meshes"), "irregular": ("mt1", "the MT1 meshes before the jitter")}
 MARKERS = {"A": "o", "B": "s", "C": "^", "D": "v", "E": "D", "ED": "P", "S": "X", "J": "h"}
 
 
@@ -65,7 +69,7 @@ def plot_errors(rows, out_dir):
     by = defaultdict(list)
     for r in rows:
         by[(r["family"], r["quantity"], r["method"])].append(r)
-    families = sorted({r["family"] for r in rows if r["family"] in ("mt1", "mt2")})
+    families = [f for f in PLOTTED_FAMILIES if any(r["family"] == f for r in rows)]
     methods = list(dict.fromkeys(r["method"] for r in rows))
     written = []
     for fam in families:
@@ -85,10 +89,10 @@ def plot_errors(rows, out_dir):
                     all_x += x
                     all_e += e
                     ax.plot(x, e, "-", marker=MARKERS.get(m, "o"), color=color, label=m)
-                    if fam == "mt1":
-                        octa = by.get(("octa", q, m), [])
-                        if octa:
-                            ax.plot([1 / fnum(r["h"]) for r in octa], [fnum(r[col]) for r in octa],
+                    if fam in COMPANION:
+                        other = by.get((COMPANION[fam][0], q, m), [])
+                        if other:
+                            ax.plot([1 / fnum(r["h"]) for r in other], [fnum(r[col]) for r in other],
                                     linestyle="none", marker=MARKERS.get(m, "o"), mfc="none", color=color)
                     for r in by.get(("rivara-" + fam, q, m), []):
                         xi, ei = 1 / fnum(r["h"]), fnum(r[col])
@@ -103,8 +107,12 @@ def plot_errors(rows, out_dir):
                 ax.set_title(f"{QUANTITIES[q]}, {title}")
                 ax.grid(True, which="both", alpha=0.3)
             axes[1].legend(fontsize=7, ncol=2)
-            note = "stars: inhomogeneous mesh (Rivara)" + (", open markers: octahedron meshes" if fam == "mt1" else "")
-            fig.suptitle(f"RBC, {fam.upper()} meshes ({note})", fontsize=10)
+            notes = (["stars: inhomogeneous mesh (Rivara)"] if fam != "irregular" else [])
+            if fam in COMPANION and any((COMPANION[fam][0], q, m) in by for m in methods):
+                notes.append("open markers: " + COMPANION[fam][1])
+            note = ", ".join(notes) or "irregular meshes"
+            fam_title = "irregular (MT1 jittered)" if fam == "irregular" else fam.upper()
+            fig.suptitle(f"RBC, {fam_title} meshes ({note})", fontsize=10)
             fig.tight_layout()
             name = f"errors_{q}_{fam}.png"
             fig.savefig(os.path.join(out_dir, name), dpi=110)
@@ -120,7 +128,7 @@ def plot_values(out_dir):
             fam, tri = name[len("values_"):-len(".csv")].rsplit("_", 1)
             files[fam][int(tri)] = name
     written = []
-    for fam in ("mt1", "mt2"):
+    for fam in PLOTTED_FAMILIES:
         sizes = [n for n in files.get(fam, {}) if n <= 5120]
         if not sizes:
             continue

@@ -21,11 +21,13 @@ namespace {
 namespace fs = std::filesystem;
 
 struct RbcArgs {
-  std::vector<std::string> families = {"mt1", "mt2", "octa", "inhomogeneous"};
+  std::vector<std::string> families = {"mt1", "mt2", "octa", "inhomogeneous", "irregular"};
   std::vector<std::string> methods = bending_method_names();
   int max_triangles = 81920;  // the paper's largest meshes; the whole study takes a few minutes
   std::optional<int> rings;  // none: the methods' default
   std::string base = "default";
+  double jitter = kDefaultJitterFraction;
+  std::uint64_t jitter_seed = kDefaultJitterSeed;
   std::string out;
   bool plots = true;
   std::string plot_script;
@@ -49,6 +51,8 @@ void run_rbc(const RbcArgs& a) {
   o.methods = a.methods;
   o.max_triangles = a.max_triangles;
   o.base = a.base;
+  o.jitter = a.jitter;
+  o.jitter_seed = a.jitter_seed;
   if (a.rings) {
     if (*a.rings < 1 || *a.rings > 3) throw Error(fmt::format("--rings must be 1, 2 or 3, got {}", *a.rings));
     o.method_options["rings"] = std::to_string(*a.rings);
@@ -98,7 +102,7 @@ std::vector<std::string> split_list(const std::string& s) {
 
 const CommandRegistration registration([](CLI::App& app) {
   auto args = std::make_shared<RbcArgs>();
-  auto families = std::make_shared<std::string>("mt1,mt2,octa,inhomogeneous");
+  auto families = std::make_shared<std::string>("mt1,mt2,octa,inhomogeneous,irregular");
   auto methods = std::make_shared<std::string>(method_names_joined(","));
   auto* cmd = app.add_subcommand(
       "rbc",
@@ -111,7 +115,8 @@ const CommandRegistration registration([](CLI::App& app) {
       "the PNG plots");
   cmd->add_option("--families", *families,
                   "comma-separated mesh families: mt1 (Loop), mt2 (midpoint), octa (octahedron: 512, 2048, ...), "
-                  "inhomogeneous (320-triangle MT1 and MT2 spheres + 3 Rivara passes; always run in full)")
+                  "inhomogeneous (320-triangle MT1 and MT2 spheres + 3 Rivara passes; always run in full), "
+                  "irregular (MT1 with every node jittered, see --jitter: 320, 1280, ...)")
       ->capture_default_str();
   cmd->add_option("--max-triangles", args->max_triangles,
                   "largest homogeneous mesh, at least 320 (320, 1280, 5120, 20480, 81920 for MT1/MT2)")
@@ -124,6 +129,14 @@ const CommandRegistration registration([](CLI::App& app) {
                   "icosahedron of MT1/MT2: default (vertices at (+-1, +-phi, 0), four on the rim) or polar "
                   "(a vertex at each pole)")
       ->check(CLI::IsMember({"default", "polar"}))
+      ->capture_default_str();
+  cmd->add_option("--jitter", args->jitter,
+                  "irregular family: every node of the MT1 sphere moves in its tangent plane by this fraction of "
+                  "the mean length of its edges, in a random direction, and is projected back onto the sphere "
+                  "(bendlab mesh --help); a fraction that folds a triangle of any of the study's irregular meshes "
+                  "is refused before any work")
+      ->capture_default_str();
+  cmd->add_option("--jitter-seed", args->jitter_seed, "irregular family: base seed; level k uses seed (base + k)")
       ->capture_default_str();
   cmd->add_option("--out", args->out, "output folder (created if missing)")->required();
   cmd->add_flag("--plots,!--no-plots", args->plots, "run scripts/plot_rbc.py on the output to draw the PNG plots "

@@ -52,8 +52,10 @@ void bind_mesh(py::module_& m) {
       },
       py::arg("family") = "mt1", py::arg("level") = 3, py::arg("rivara_passes") = 0,
       "A unit-sphere mesh of the paper's families (docs/conventions.md §4): 'mt1' (icosahedron + Loop "
-      "refinement), 'mt2' (midpoints) or 'octa'; level k (0..8) gives 20*4^k (8*4^k) triangles; rivara_passes "
-      "(0..6) longest-edge bisection passes make the inhomogeneous meshes. The limits are bendlab mesh's.");
+      "refinement), 'mt2' (midpoints), 'octa' or 'irregular' (MT1 with every node jittered tangentially "
+      "by 0.25 of its mean edge length, seed 28 + level); level k (0..8) gives 20*4^k (8*4^k) triangles; "
+      "rivara_passes (0..6) longest-edge bisection passes make the inhomogeneous meshes. The limits are bendlab "
+      "mesh's.");
   m.def(
       "level_with_triangles",
       [](const std::string& family, long triangles) { return level_with_triangles(parse_mesh_family(family), triangles); },

@@ -98,7 +98,9 @@ nlohmann::json to_json(const RbcStudyResult& s, const std::vector<ErrorRow>& row
                   {"methods", s.options.methods},
                   {"max_triangles", s.options.max_triangles},
                   {"base", s.options.base},
-                  {"rings", rings}};
+                  {"rings", rings},
+                  {"jitter", s.options.jitter},
+                  {"jitter_seed", s.options.jitter_seed}};
   j["thresholds"] = {{"tail_points", ct.tail_points},
                      {"to_zero_slope", ct.to_zero_slope},
                      {"diverge_slope", ct.diverge_slope},
@@ -181,7 +183,7 @@ std::string table2_text(const std::vector<RateFit>& fits, const RbcStudyResult& 
       "■ diverges: either slope >= {:+};\n"
       "○ converges to a systematic error: otherwise. Empty: the method does not compute the quantity.\n",
       ct.tail_points, ct.to_zero_slope, ct.diverge_slope);
-  for (const std::string fam : {"mt1", "mt2", "octa"}) {
+  for (const std::string fam : {"mt1", "mt2", "octa", "irregular"}) {
     if (std::none_of(fits.begin(), fits.end(), [&](const RateFit& f) { return f.family == fam; })) continue;
     for (const std::string measure : {"max", "avg"})
       md += fmt::format("\n## {}, {} error\n\n{}", fam, measure == "max" ? "maximal" : "average",

@@ -41,6 +41,7 @@ std::vector<MeshSpec> mesh_specs(const RbcStudyOptions& o) {
     if (fam == "mt1") homogeneous("mt1", MeshFamily::MT1, 2);
     if (fam == "mt2") homogeneous("mt2", MeshFamily::MT2, 2);
     if (fam == "octa") homogeneous("octa", MeshFamily::Octa, 3);
+    if (fam == "irregular") homogeneous("irregular", MeshFamily::Irregular, 2);
     if (fam == "inhomogeneous") {
       specs.push_back({"rivara-mt1", "mt1", MeshFamily::MT1, kRivaraLevel, kRivaraPasses});
       specs.push_back({"rivara-mt2", "mt2", MeshFamily::MT2, kRivaraLevel, kRivaraPasses});
@@ -49,12 +50,15 @@ std::vector<MeshSpec> mesh_specs(const RbcStudyOptions& o) {
   return specs;
 }
 
-// sphere_mesh(), or with the icosahedron rotated to a vertex at each pole.
-TriMesh study_sphere(const MeshSpec& spec, const std::string& base) {
-  if (base != "polar" || spec.generator == MeshFamily::Octa)
-    return sphere_mesh(spec.generator, spec.level, spec.passes);
-  TriMesh m = icosahedron_polar();
-  for (int k = 0; k < spec.level; ++k) m = spec.generator == MeshFamily::MT1 ? refine_loop(m) : refine_midpoint(m);
+// sphere_mesh(), or with the icosahedron rotated to a vertex at each pole; the irregular family
+// jitters MT1 of that orientation with the study's fraction and seed.
+TriMesh study_sphere(const MeshSpec& spec, const RbcStudyOptions& o) {
+  const bool irregular = spec.generator == MeshFamily::Irregular;
+  const MeshFamily generator = irregular ? MeshFamily::MT1 : spec.generator;
+  TriMesh m = o.base != "polar" || generator == MeshFamily::Octa ? sphere_mesh(generator, spec.level) : icosahedron_polar();
+  if (o.base == "polar" && generator != MeshFamily::Octa)
+    for (int k = 0; k < spec.level; ++k) m = generator == MeshFamily::MT1 ? refine_loop(m) : refine_midpoint(m);
+  if (irregular) m = jitter_sphere(m, o.jitter, o.jitter_seed + static_cast<std::uint64_t>(spec.level));
   for (int p = 0; p < spec.passes; ++p) m = rivara_pass(m);
   return m;
 }
@@ -66,7 +70,7 @@ void report(const RbcStudyOptions& o, const std::string& line) {
 }  // namespace
 
 const std::vector<std::string>& rbc_study_families() {
-  static const std::vector<std::string> f = {"mt1", "mt2", "octa", "inhomogeneous"};
+  static const std::vector<std::string> f = {"mt1", "mt2", "octa", "inhomogeneous", "irregular"};
   return f;
 }
 
@@ -74,7 +78,7 @@ void validate(const RbcStudyOptions& o) {
   if (o.families.empty()) throw Error("--families: no mesh family given");
   for (const std::string& f : o.families)
     if (std::find(rbc_study_families().begin(), rbc_study_families().end(), f) == rbc_study_families().end())
-      throw Error(fmt::format("--families: unknown family '{}' (expected mt1, mt2, octa, inhomogeneous)", f));
+      throw Error(fmt::format("--families: unknown family '{}' (expected mt1, mt2, octa, inhomogeneous, irregular)", f));
   if (o.methods.empty()) throw Error("--methods: no method given");
   for (const auto& [key, value] : o.method_options) {
     bool taken = false;
@@ -100,6 +104,17 @@ void validate(const RbcStudyOptions& o) {
     throw Error(fmt::format("kappa_b must be positive and finite, got {}", o.kappa_b));
   if (!(o.radius > 0) || !std::isfinite(o.radius))
     throw Error(fmt::format("radius must be positive and finite, got {}", o.radius));
+  if (!(o.jitter >= 0) || !std::isfinite(o.jitter))
+    throw Error(fmt::format("--jitter: the fraction must be finite and >= 0, got {}", o.jitter));
+  // A fold is found only by making the mesh; the irregular meshes are cheap beside the study.
+  for (const MeshSpec& spec : mesh_specs(o)) {
+    if (spec.generator != MeshFamily::Irregular) continue;
+    try {
+      study_sphere(spec, o);
+    } catch (const Error& e) {
+      throw Error(fmt::format("--jitter: {}", e.what()));
+    }
+  }
 }
 
 Scalars polar_angle(const Points& x) {
@@ -134,7 +149,7 @@ RbcStudyResult run_rbc_study(const RbcStudyOptions& o) {
   for (const std::string& m : o.methods) methods.push_back(make_bending_method(m, options_for(o, m)));
 
   for (const MeshSpec& spec : mesh_specs(o)) {
-    const TriMesh sphere = study_sphere(spec, o.base);
+    const TriMesh sphere = study_sphere(spec, o);
     const TriMesh mesh(sphere.topology_ptr(), rbc->map_from_unit_sphere(sphere.positions()));
     MeshRun run;
     run.family = spec.family;

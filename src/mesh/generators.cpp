@@ -8,6 +8,7 @@
 
 #include <Eigen/Geometry>
 
+#include "bendlab/mesh/jitter.hpp"
 #include "bendlab/mesh/subdivision.hpp"
 
 namespace bendlab {
@@ -18,7 +19,8 @@ MeshFamily parse_mesh_family(const std::string& name) {
   if (s == "mt1") return MeshFamily::MT1;
   if (s == "mt2") return MeshFamily::MT2;
   if (s == "octa") return MeshFamily::Octa;
-  throw Error("unknown mesh family '" + name + "' (expected mt1, mt2 or octa)");
+  if (s == "irregular") return MeshFamily::Irregular;
+  throw Error("unknown mesh family '" + name + "' (expected mt1, mt2, octa or irregular)");
 }
 
 std::string to_string(MeshFamily family) {
@@ -26,6 +28,7 @@ std::string to_string(MeshFamily family) {
     case MeshFamily::MT1: return "mt1";
     case MeshFamily::MT2: return "mt2";
     case MeshFamily::Octa: return "octa";
+    case MeshFamily::Irregular: return "irregular";
   }
   throw Error("invalid MeshFamily value");
 }
@@ -238,9 +241,17 @@ void check_sphere_mesh_arguments(int level, int rivara_passes, const std::string
 TriMesh sphere_mesh(MeshFamily family, int level, int rivara_passes) {
   check_sphere_mesh_arguments(level, rivara_passes);
   TriMesh m = family == MeshFamily::Octa ? octahedron() : icosahedron();
-  for (int k = 0; k < level; ++k) m = family == MeshFamily::MT1 ? refine_loop(m) : refine_midpoint(m);
+  if (family == MeshFamily::Irregular) {
+    m = irregular_sphere_mesh(level);
+  } else {
+    for (int k = 0; k < level; ++k) m = family == MeshFamily::MT1 ? refine_loop(m) : refine_midpoint(m);
+  }
   for (int p = 0; p < rivara_passes; ++p) m = rivara_pass(m);
   return m;
+}
+
+TriMesh irregular_sphere_mesh(int level, double fraction, std::uint64_t base_seed) {
+  return jitter_sphere(sphere_mesh(MeshFamily::MT1, level), fraction, base_seed + static_cast<std::uint64_t>(level));
 }
 
 int level_with_triangles(MeshFamily family, long triangles) {

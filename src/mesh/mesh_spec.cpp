@@ -12,7 +12,7 @@ namespace bendlab {
 
 TriMesh mesh_from_spec(const std::string& spec) {
   std::smatch m;
-  if (std::regex_match(spec, m, std::regex(R"((mt1|mt2|octa):(\d{1,9}))"))) {
+  if (std::regex_match(spec, m, std::regex(R"((mt1|mt2|octa|irregular):(\d{1,9}))"))) {
     const MeshFamily family = parse_mesh_family(m[1]);
     const long triangles = std::stol(m[2]);
     const int level = level_with_triangles(family, triangles);
@@ -24,7 +24,7 @@ TriMesh mesh_from_spec(const std::string& spec) {
   if (std::regex_match(spec, m, std::regex(R"(inh:(mt1|mt2))"))) return sphere_mesh(parse_mesh_family(m[1]), 2, 3);
   std::error_code ec;
   if (!std::filesystem::exists(spec, ec))
-    throw Error(fmt::format("--mesh '{}' is neither mt1:N, mt2:N, octa:N, inh:mt1, inh:mt2 nor an existing file", spec));
+    throw Error(fmt::format("--mesh '{}' is neither mt1:N, mt2:N, octa:N, irregular:N, inh:mt1, inh:mt2 nor an existing file", spec));
   return read_mesh(spec);
 }
 

@@ -1,9 +1,12 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
 #include "bendlab/analysis/rbc_study.hpp"
+#include "bendlab/mesh/generators.hpp"
+#include "bendlab/surfaces/analytic_surface.hpp"
 
 using namespace bendlab;
 
@@ -149,4 +152,71 @@ TEST(RbcStudy, PolarBaseRotatesTheIcosahedron) {
   EXPECT_GT(d.meshes[0].theta[0], 0.1);
   o.base = "sideways";
   EXPECT_THROW(validate(o), Error);
+}
+
+TEST(RbcStudy, IrregularFamilyIsMT1JitteredAfreshOnEveryLevel) {
+  RbcStudyOptions o;
+  o.families = {"irregular"};
+  o.methods = {"C"};
+  o.max_triangles = 1280;
+  const RbcStudyResult r = run_rbc_study(o);
+  ASSERT_EQ(r.meshes.size(), 2u);
+  const auto rbc = make_rbc(1.0);
+  for (int k = 0; k < 2; ++k) {
+    const MeshRun& m = r.meshes[k];
+    EXPECT_EQ(m.family, "irregular");
+    EXPECT_EQ(m.origin, "irregular");
+    EXPECT_FALSE(m.inhomogeneous);
+    EXPECT_EQ(m.level, k + 2);
+    EXPECT_EQ(m.triangles, 320 << (2 * k));
+    EXPECT_EQ(m.x, rbc->map_from_unit_sphere(irregular_sphere_mesh(m.level).positions()));
+  }
+  o.jitter_seed = 1;
+  o.max_triangles = 320;
+  const RbcStudyResult other = run_rbc_study(o);
+  EXPECT_EQ(other.meshes[0].x, rbc->map_from_unit_sphere(irregular_sphere_mesh(2, 0.25, 1).positions()));
+  EXPECT_NE(other.meshes[0].x, r.meshes[0].x);
+}
+
+TEST(RbcStudy, IrregularFamilyLeavesTheOtherFamiliesAlone) {
+  RbcStudyOptions o;
+  o.families = {"mt1"};
+  o.methods = {"C"};
+  o.max_triangles = 320;
+  const std::vector<ErrorRow> alone = run_rbc_study(o).rows();
+  o.families = {"irregular", "mt1"};
+  std::vector<ErrorRow> both = run_rbc_study(o).rows();
+  both.erase(std::remove_if(both.begin(), both.end(), [](const ErrorRow& e) { return e.family == "irregular"; }),
+             both.end());
+  ASSERT_EQ(both.size(), alone.size());
+  for (std::size_t i = 0; i < both.size(); ++i) {
+    EXPECT_EQ(both[i].family, alone[i].family);
+    EXPECT_EQ(both[i].quantity, alone[i].quantity);
+    EXPECT_EQ(both[i].max_error, alone[i].max_error);  // bit for bit
+    EXPECT_EQ(both[i].avg_error, alone[i].avg_error);
+  }
+}
+
+TEST(RbcStudy, RefusesAJitterThatFoldsBeforeAnyWork) {
+  RbcStudyOptions o;
+  o.families = {"mt1", "irregular"};
+  o.methods = {"C"};
+  o.max_triangles = 320;
+  o.jitter = 1.0;  // a whole mean edge length: the neighbours' edges are crossed
+  int lines = 0;
+  o.progress = [&](const std::string&) { ++lines; };
+  try {
+    run_rbc_study(o);
+    FAIL() << "a jitter of 1 was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("--jitter: jitter fraction 1 folds triangle"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(lines, 0);  // not even the MT1 mesh ran
+  o.jitter = -0.1;
+  EXPECT_THROW(validate(o), Error);
+  o.jitter = NAN;
+  EXPECT_THROW(validate(o), Error);
+  o.jitter = 1.0;
+  o.families = {"mt1"};
+  EXPECT_NO_THROW(validate(o));  // no irregular mesh in the study
 }

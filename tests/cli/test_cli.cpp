@@ -270,6 +270,40 @@ TEST_F(Cli, RefusesBadArgumentsBeforeWork) {
                  "garbage.off", csv);
 }
 
+TEST_F(Cli, IrregularFamily) {
+  const fs::path out = dir / "i.off";
+  const CliRun r = run("mesh --family irregular --level 2 --shape rbc --out " + out.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["triangles"], 320);
+  EXPECT_EQ(j["jitter"], 0.25);
+  EXPECT_EQ(j["jitter_seed"], 30);  // the default base 28 + level 2
+  EXPECT_TRUE(fs::exists(out));
+  // The same mesh again, and another with another seed.
+  const fs::path again = dir / "j.off", other = dir / "k.off";
+  ASSERT_EQ(run("mesh --family irregular --level 2 --shape rbc --jitter 0.25 --jitter-seed 28 --out " + again.string()).status, 0);
+  ASSERT_EQ(run("mesh --family irregular --level 2 --shape rbc --jitter-seed 5 --out " + other.string()).status, 0);
+  EXPECT_EQ(slurp(out), slurp(again));
+  EXPECT_NE(slurp(out), slurp(other));
+}
+
+TEST_F(Cli, RefusesAJitterThatFolds) {
+  // A step of a whole mean edge length crosses the neighbours' edges.
+  const fs::path out = dir / "m.off";
+  expect_refused(run("mesh --family irregular --level 3 --jitter 1 --out " + out.string()),
+                 "--jitter: jitter fraction 1 folds triangle", out);
+  expect_refused(run("mesh --family irregular --level 3 --jitter -0.5 --out " + out.string()), "--jitter", out);
+  expect_refused(run("mesh --family mt1 --level 3 --jitter 0.1 --out " + out.string()), "--family irregular only",
+                 out);
+  const fs::path study = dir / "study";
+  expect_refused(run("rbc --families mt1,irregular --max-triangles 320 --methods C --jitter 1 --no-plots --out " +
+                     study.string()),
+                 "--jitter: jitter fraction 1 folds triangle", study);
+  expect_refused(run("rbc --families irregular --max-triangles 320 --methods C --jitter inf --no-plots --out " +
+                     study.string()),
+                 "--jitter", study);
+}
+
 TEST_F(Cli, ShearRefusesBadParametersBeforeWork) {
   const fs::path out = dir / "run";
   expect_refused(run("shear --G -0.1 --out " + out.string()), "--G", out);

@@ -12,6 +12,9 @@
 //                      three Rivara passes (about 3900 triangles). These two meshes are run
 //                      whatever max_triangles is, because table 3 needs them. Method S refuses
 //                      them (MethodRun::refused).
+//   "irregular"        levels 2, 3, ... of MT1 with every node jittered tangentially by `jitter`
+//                      times its mean edge length, seed jitter_seed + level (jitter.hpp), so the
+//                      meshes stay irregular under refinement: N_T = 320, 1280, ..., 81920
 // h is the mean edge length of the mapped (RBC) mesh.
 #include <functional>
 #include <string>
@@ -20,13 +23,14 @@
 #include "bendlab/analysis/convergence.hpp"
 #include "bendlab/analysis/error_measures.hpp"
 #include "bendlab/bending/method_registry.hpp"
+#include "bendlab/mesh/jitter.hpp"
 #include "bendlab/mesh/trimesh.hpp"
 #include "bendlab/surfaces/analytic_surface.hpp"
 
 namespace bendlab {
 
 struct RbcStudyOptions {
-  std::vector<std::string> families = {"mt1", "mt2", "octa", "inhomogeneous"};
+  std::vector<std::string> families = {"mt1", "mt2", "octa", "inhomogeneous", "irregular"};
   /// Every registered method by default (method_registry.hpp), in the registry's order.
   std::vector<std::string> methods = bending_method_names();
   /// Method options (e.g. {"rings", "2"}), each passed to the methods whose schema has it (rings:
@@ -38,6 +42,10 @@ struct RbcStudyOptions {
   /// pole). Method S's errors depend on it (the extraordinary vertices' positions); the other
   /// methods' hardly.
   std::string base = "default";
+  /// The irregular family: the fraction of its mean edge length by which each node moves, and the
+  /// base seed (level k: jitter_seed + k). The jitter is applied to MT1 of `base`.
+  double jitter = kDefaultJitterFraction;
+  std::uint64_t jitter_seed = kDefaultJitterSeed;
   double kappa_b = 1.0;
   double radius = 1.0;
   /// Per-node data (numerical results, errors) are kept for meshes with N_T <= this, and for the
@@ -50,7 +58,8 @@ struct RbcStudyOptions {
 /// The families a study accepts.
 const std::vector<std::string>& rbc_study_families();
 /// Throws bendlab::Error (one line) for an unknown family or method, max_triangles < 320, a
-/// non-positive kappa_b or radius, or method options that a method refuses.
+/// non-positive kappa_b or radius, method options that a method refuses, or a jitter that folds a
+/// triangle of an irregular mesh of the study (the irregular meshes are generated to check that).
 void validate(const RbcStudyOptions& options);
 
 struct MethodRun {
@@ -68,7 +77,7 @@ struct MethodRun {
 };
 
 struct MeshRun {
-  std::string family;        ///< "mt1", "mt2", "octa", "rivara-mt1", "rivara-mt2"
+  std::string family;        ///< "mt1", "mt2", "octa", "rivara-mt1", "rivara-mt2", "irregular"
   std::string origin;        ///< homogeneous family of the mesh ("mt1" for "rivara-mt1")
   bool inhomogeneous = false;
   int level = 0, triangles = 0, vertices = 0;

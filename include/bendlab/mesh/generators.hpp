@@ -7,16 +7,20 @@
 //   MT2:  icosahedron, k midpoint subdivision steps, projected after each step.
 //   Octa: octahedron, k midpoint subdivision steps, projected after each step.
 //   Inhomogeneous: a sphere mesh followed by passes of Rivara's longest-edge bisection.
-// N_T = 20 * 4^k (icosahedron) or 8 * 4^k (octahedron).
+//   Irregular: MT1 at level k with every node jittered tangentially (jitter.hpp) by a fraction
+//         (default 0.25) of its mean edge length, seed base + k (default base 28).
+// N_T = 20 * 4^k (icosahedron, irregular) or 8 * 4^k (octahedron).
+#include <cstdint>
 #include <string>
 
+#include "bendlab/mesh/jitter.hpp"
 #include "bendlab/mesh/trimesh.hpp"
 
 namespace bendlab {
 
-enum class MeshFamily { MT1, MT2, Octa };
+enum class MeshFamily { MT1, MT2, Octa, Irregular };
 
-/// "mt1", "mt2", "octa" (case-insensitive); throws bendlab::Error otherwise.
+/// "mt1", "mt2", "octa", "irregular" (case-insensitive); throws bendlab::Error otherwise.
 MeshFamily parse_mesh_family(const std::string& name);
 std::string to_string(MeshFamily family);
 
@@ -59,7 +63,13 @@ void check_sphere_mesh_arguments(int level, int rivara_passes, const std::string
                                  const std::string& rivara_name = "rivara_passes");
 
 /// The unit sphere of a family at refinement level k, then `rivara_passes` Rivara passes
-/// (check_sphere_mesh_arguments first).
+/// (check_sphere_mesh_arguments first). The irregular family with the default fraction and seed
+/// (irregular_sphere_mesh).
 TriMesh sphere_mesh(MeshFamily family, int level, int rivara_passes = 0);
+
+/// The irregular family at level k: MT1 of level k, jitter_sphere(mt1, fraction, base_seed + k).
+/// Throws bendlab::Error (one line) for a fraction that folds a triangle (jitter.hpp).
+TriMesh irregular_sphere_mesh(int level, double fraction = kDefaultJitterFraction,
+                              std::uint64_t base_seed = kDefaultJitterSeed);
 
 }  // namespace bendlab
