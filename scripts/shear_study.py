@@ -82,6 +82,9 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from inset_limits import inset_ylim  # noqa: E402
+
 ROOT = Path(__file__).resolve().parent.parent
 METHODS = []  # the bending methods, from `bendlab methods --json` (set in main)
 G_SWEEP = [0.0125, 0.025, 0.05, 0.1, 0.2]
@@ -538,7 +541,12 @@ def section_b(results, runs, fig_dir, rel, t_end, none_results, suffix="", integ
     lines.append("All methods on MT1 meshes, gamma t from 0 to " + fmt_g(t_end) + ". The grey dashed "
                  "curve is the capsule without bending (kB_hat = 0) at the same G and resolution, when "
                  "that run exists. The paper's figure 14 shows 5120 triangles, figure 13 the resolutions "
-                 "320, 1280, 5120 per method at G = 0.2.")
+                 "320, 1280, 5120 per method at G = 0.2."
+                 + (" The inset magnifies gamma t in [5, " + fmt_g(t_end) + "] on the curves with bending: "
+                    "its vertical range is theirs in that window plus 15 % (scripts/inset_limits.py), so "
+                    "the no-bending curve, and a method whose mean there lies more than 5 % from the "
+                    "median of the methods (named in the inset's title), are seen on the main axes only."
+                    if t_end > 5 else ""))
     lines.append("")
     triangles = sorted({r.triangles for r in runs})
     for (G, kb) in PAIRS:
@@ -546,7 +554,6 @@ def section_b(results, runs, fig_dir, rel, t_end, none_results, suffix="", integ
         lines.append("")
         for n in triangles:
             fig, ax = plt.subplots(figsize=(7.0, 4.6))
-            ins = ax.inset_axes([0.5, 0.1, 0.46, 0.42]) if t_end > 5 else None
             curves = []
             ref = none_results.get((n, G))
             if ref is not None and ref.ok and ref.series:
@@ -557,18 +564,33 @@ def section_b(results, runs, fig_dir, rel, t_end, none_results, suffix="", integ
                     curves.append((m, m, r.series))
             for label, key, s in curves:
                 ax.plot(s["gamma_t"], s["D"], label=label, **METHOD_STYLE.get(key, {}))
-                if ins is not None:
+            # The inset zooms on the steady state of the methods with bending (inset_limits.py):
+            # the no-bending curve, and a method far from the others, stay on the main axes only.
+            # It sits in the empty band between the bending curves and the no-bending one; the
+            # main axes reach 1.9 times the highest bending curve to make room for it.
+            lim = (inset_ylim([(k, s["gamma_t"], s["D"]) for _, k, s in curves], (5.0, t_end))
+                   if t_end > 5 else None)
+            top = max([float(np.max(s["D"])) for _, _, s in curves] or [1.0])
+            if lim is not None:
+                lo, hi, left_out = lim
+                bend_top = max(float(np.max(s["D"])) for _, k, s in curves if k != "none")
+                top = max(top, 1.9 * bend_top)
+                ins = ax.inset_axes([0.42, 0.5, 0.55, 0.34])
+                for label, key, s in curves:
                     sel = s["gamma_t"] >= 5
-                    ins.plot(s["gamma_t"][sel], s["D"][sel], **METHOD_STYLE.get(key, {}))
-            if ins is not None:
+                    if key not in left_out:
+                        ins.plot(s["gamma_t"][sel], s["D"][sel], **METHOD_STYLE.get(key, {}))
                 ins.set_xlim(5, t_end)
+                ins.set_ylim(lo, hi)
                 ins.tick_params(labelsize=7)
                 ins.grid(alpha=0.3)
-                ins.set_title(r"$\dot\gamma t \in [5, %g]$" % t_end, fontsize=8)
+                off = [("no bending" if k == "none" else k) for k in left_out]
+                ins.set_title(r"$\dot\gamma t \in [5, %g]$" % t_end
+                              + (" (not shown: " + ", ".join(off) + ")" if off else ""), fontsize=8)
             ax.set_xlabel(r"$\dot\gamma t$")
             ax.set_ylabel("D")
             ax.set_xlim(0, t_end)
-            ax.set_ylim(bottom=0)
+            ax.set_ylim(0, 1.05 * top)
             ax.grid(alpha=0.3)
             ax.legend(loc="upper left", fontsize=8, ncol=2)
             ax.set_title(f"G = {fmt_g(G)}, kB_hat = {fmt_g(kb)}, {n} triangles")
