@@ -84,6 +84,7 @@ import numpy as np  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from inset_limits import inset_ylim  # noqa: E402
+import small_g_study  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 METHODS = []  # the bending methods, from `bendlab methods --json` (set in main)
@@ -800,6 +801,10 @@ def section_e(results, runs, fig_dir, rel, t_end, n, meta):
     if runs_a and all(r in results for r in runs_a):
         lines += demote(section_a(results, runs_a, fig_dir, rel, t_end, suffix),
                         f"(e.1) No bending: deformation against shear rate (figure 12), {n} triangles")
+        # Beside the table: why its smallest G differs between the resolutions (the runs of
+        # scripts/small_g_study.py, in studies/small_g).
+        if n == 5120 and t_end >= 10 and E_QUADRATURE == "tree-mixed":
+            lines += small_g_study.section(fig_dir, rel)
 
     # Figure 14: every method at the two cases of the paper.
     none_results = {(n, G): results[r] for r in runs_a if r in results for (G, kb) in PAIRS if close(r.G, G)}
@@ -1103,6 +1108,7 @@ def main():
         sys.exit(f"error: no bendlab binary at '{args.bendlab}' (build it: cmake --preset release && "
                  "cmake --build --preset release, or pass --bendlab PATH)")
     METHODS[:] = bending_methods(bendlab)
+    small_g_study.BENDLAB = bendlab  # writes the meshes its shape pictures need
     work = Path(args.work).resolve()
     doc = Path(args.doc).resolve()
     fig_dir = doc.with_suffix("")
