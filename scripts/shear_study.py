@@ -26,7 +26,9 @@ Writes docs/results/shear.md and the PNGs it shows (docs/results/shear/):
       gamma dt beside RKC's mean step, BIM evaluations and stages), figure 16 (C and S at G = 0.05,
       kB_hat = 0.0375), figure 17 (A and C at kB_hat = 2/15, G = 0.05 and 0.2) and the study's wall
       time. 5 + 2 x (number of methods) + 4 runs (25 with A, B, C, D, E, ED, S, J). The paper gives
-      the literature values of figures 16 and 17 only as plots, so they are not drawn.
+      the literature values of figures 16 and 17 only as plots, so they are not drawn. Beside
+      figure 12's table, the runs of scripts/small_g_study.py (studies/small_g) that explain its
+      smallest G (wrinkles without bending), where they have been run.
       --bim-quadrature-e tree runs them with the BIM's tree quadrature (within 1e-5 of all7;
       Method C at 5120 to gamma t = 10 in 249 s on 2 idle cores, D_steady equal to all7's to 1.4e-7),
       --bim-quadrature-e tree-mixed with its single-precision sums (about 1.9 times faster than
