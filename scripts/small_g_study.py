@@ -358,7 +358,7 @@ def plot_time(data, path):
     a1.axhline(1.0, color="0.5", lw=0.8)
     a1.set_xlabel(r"$\dot\gamma t$")
     a1.set_ylabel(r"$D \,/\, (25/4\ G)$")
-    a1.set_ylim(0.0, 1.25)
+    a1.set_ylim(0.8, 1.25)
     a1.set_xlim(0, 10)
     a1.grid(alpha=0.3)
     a1.legend(fontsize=6.5, loc="lower right")
