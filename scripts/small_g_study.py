@@ -565,7 +565,7 @@ def findings(data):
             f"{2 * math.pi / d1['peak'] / edge_length(1280):.1f} edge lengths. The wavelength follows the mesh "
             "because a membrane without bending resistance has no length of its own to set it: the compressed "
             "regions of a neo-Hookean capsule at small capillary numbers buckle (Lac, Barthes-Biesel, Pelekasis "
-            "and Tsamopoulos 2004), and the finest pattern the mesh can carry grows. A different wrinkle pattern "
+            "and Tsamopoulos 2004), and the pattern that grows is a few edges long, whatever the mesh. A different wrinkle pattern "
             f"gives a different D: D_steady / (25/4 G) = {ratio(ref):.3f} at 5120 and {ratio(n1280):.3f} at 1280 "
             "triangles. Neither is the capsule's converged deformation.")
     if c5120 is not None:
@@ -653,8 +653,8 @@ def findings(data):
             # D linear in kB_hat between 3e-4 and 1e-3, continued to 0.
             d0 = D(w5120) + (D(w5120) - D(c5120)) * w5120.kb / (c5120.kb - w5120.kb)
             txt += (f": at G = 0.0125 D_steady rises by {pct(D(w5120), D(c5120)):+.2f} % from kB_hat = 1e-3 to 3e-4, "
-                    f"and continued linearly to kB_hat = 0 it gives D = {d0:.5f} = **{d0 / c5120.G:.3f} G**, "
-                    f"{d0 / (SLOPE * c5120.G):.3f} times the theory's 25/4 G")
+                    f"and continued linearly to kB_hat = 0 (a straight line through two points: an estimate) it gives "
+                    f"D = {d0:.5f} = **{d0 / c5120.G:.3f} G**, {d0 / (SLOPE * c5120.G):.3f} times the theory's 25/4 G")
         out.append(txt + ".")
     out += ["", "So the 1.09 of table (e.1) is no fault of the integrator or the quadrature: without bending the "
             "capsule's compressed membrane wrinkles at the mesh's own wavelength, and D at G <= 0.0125 then "
