@@ -344,7 +344,7 @@ def plot_time(data, path):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    fig, (a1, a2) = plt.subplots(1, 2, figsize=(11.5, 4.4))
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(11.5, 5.6))
     for run, d in data.items():
         if run in PART_E:
             continue
@@ -361,7 +361,7 @@ def plot_time(data, path):
     a1.set_ylim(0.8, 1.25)
     a1.set_xlim(0, 10)
     a1.grid(alpha=0.3)
-    a1.legend(fontsize=6.5, loc="lower right")
+    fig.legend(*a1.get_legend_handles_labels(), fontsize=7, loc="lower center", ncol=3)
     a2.set_xlabel(r"$\dot\gamma t$")
     a2.set_ylabel(f"rms normal displacement from the smooth shape / R")
     a2.set_yscale("log")
@@ -370,7 +370,7 @@ def plot_time(data, path):
     a2.grid(alpha=0.3)
     a2.set_title(f"smooth shape: spherical harmonics to degree {SMOOTH_DEGREE} (* end of a run without snapshots)",
                  fontsize=8)
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, 0.2, 1, 1))
     fig.savefig(path, dpi=100)
     plt.close(fig)
 
