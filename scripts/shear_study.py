@@ -26,7 +26,9 @@ Writes docs/results/shear.md and the PNGs it shows (docs/results/shear/):
       gamma dt beside RKC's mean step, BIM evaluations and stages), figure 16 (C and S at G = 0.05,
       kB_hat = 0.0375), figure 17 (A and C at kB_hat = 2/15, G = 0.05 and 0.2) and the study's wall
       time. 5 + 2 x (number of methods) + 4 runs (25 with A, B, C, D, E, ED, S, J). The paper gives
-      the literature values of figures 16 and 17 only as plots, so they are not drawn.
+      the literature values of figures 16 and 17 only as plots, so they are not drawn. Beside
+      figure 12's table, the runs of scripts/small_g_study.py (studies/small_g) that explain its
+      smallest G (wrinkles without bending), where they have been run.
       --bim-quadrature-e tree runs them with the BIM's tree quadrature (within 1e-5 of all7;
       Method C at 5120 to gamma t = 10 in 249 s on 2 idle cores, D_steady equal to all7's to 1.4e-7),
       --bim-quadrature-e tree-mixed with its single-precision sums (about 1.9 times faster than
@@ -81,6 +83,10 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from inset_limits import inset_ylim  # noqa: E402
+import small_g_study  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 METHODS = []  # the bending methods, from `bendlab methods --json` (set in main)
@@ -435,7 +441,7 @@ def fit_slope(G, D):
     return float(np.dot(G, D) / np.dot(G, G))
 
 
-def section_a(results, runs, fig_dir, rel, t_end, suffix=""):
+def section_a(results, runs, fig_dir, rel, t_end, suffix="", slope_note=""):
     lines = ["## (a) No bending: deformation against shear rate (figure 12)", ""]
     n = runs[0].triangles
     ok = [results[r] for r in runs if results[r].ok]
@@ -513,7 +519,7 @@ def section_a(results, runs, fig_dir, rel, t_end, suffix=""):
     d01 = next((r.summary["D_steady"] for r in ok if close(r.run.G, 0.1)), None)
     lines += [
         f"- Small-G slope, least squares through the origin: **D = {num(slope2, 4)} G** from the two "
-        f"smallest G, **D = {num(slope3, 4)} G** from the three smallest.",
+        f"smallest G, **D = {num(slope3, 4)} G** from the three smallest." + slope_note,
         "- Small-deformation theory (Barthes-Biesel & Rallison 1981): an initially spherical capsule in "
         "simple shear takes D = 5/4 Ca (2 + nu_s) / (1 + nu_s), with Ca = mu gamma R / Gs, Gs the "
         "small-strain shear modulus and nu_s the surface Poisson ratio of the membrane, whatever the "
@@ -538,7 +544,12 @@ def section_b(results, runs, fig_dir, rel, t_end, none_results, suffix="", integ
     lines.append("All methods on MT1 meshes, gamma t from 0 to " + fmt_g(t_end) + ". The grey dashed "
                  "curve is the capsule without bending (kB_hat = 0) at the same G and resolution, when "
                  "that run exists. The paper's figure 14 shows 5120 triangles, figure 13 the resolutions "
-                 "320, 1280, 5120 per method at G = 0.2.")
+                 "320, 1280, 5120 per method at G = 0.2."
+                 + (" The inset magnifies gamma t in [5, " + fmt_g(t_end) + "] on the curves with bending: "
+                    "its vertical range is theirs in that window plus 15 % (scripts/inset_limits.py), so "
+                    "the no-bending curve, and a method whose mean there lies more than 5 % from the "
+                    "median of the methods (named in the inset's title), are seen on the main axes only."
+                    if t_end > 5 else ""))
     lines.append("")
     triangles = sorted({r.triangles for r in runs})
     for (G, kb) in PAIRS:
@@ -546,7 +557,6 @@ def section_b(results, runs, fig_dir, rel, t_end, none_results, suffix="", integ
         lines.append("")
         for n in triangles:
             fig, ax = plt.subplots(figsize=(7.0, 4.6))
-            ins = ax.inset_axes([0.5, 0.1, 0.46, 0.42]) if t_end > 5 else None
             curves = []
             ref = none_results.get((n, G))
             if ref is not None and ref.ok and ref.series:
@@ -557,18 +567,33 @@ def section_b(results, runs, fig_dir, rel, t_end, none_results, suffix="", integ
                     curves.append((m, m, r.series))
             for label, key, s in curves:
                 ax.plot(s["gamma_t"], s["D"], label=label, **METHOD_STYLE.get(key, {}))
-                if ins is not None:
+            # The inset zooms on the steady state of the methods with bending (inset_limits.py):
+            # the no-bending curve, and a method far from the others, stay on the main axes only.
+            # It sits in the empty band between the bending curves and the no-bending one; the
+            # main axes reach 1.9 times the highest bending curve to make room for it.
+            lim = (inset_ylim([(k, s["gamma_t"], s["D"]) for _, k, s in curves], (5.0, t_end))
+                   if t_end > 5 else None)
+            top = max([float(np.max(s["D"])) for _, _, s in curves] or [1.0])
+            if lim is not None:
+                lo, hi, left_out = lim
+                bend_top = max(float(np.max(s["D"])) for _, k, s in curves if k != "none")
+                top = max(top, 1.9 * bend_top)
+                ins = ax.inset_axes([0.42, 0.5, 0.55, 0.34])
+                for label, key, s in curves:
                     sel = s["gamma_t"] >= 5
-                    ins.plot(s["gamma_t"][sel], s["D"][sel], **METHOD_STYLE.get(key, {}))
-            if ins is not None:
+                    if key not in left_out:
+                        ins.plot(s["gamma_t"][sel], s["D"][sel], **METHOD_STYLE.get(key, {}))
                 ins.set_xlim(5, t_end)
+                ins.set_ylim(lo, hi)
                 ins.tick_params(labelsize=7)
                 ins.grid(alpha=0.3)
-                ins.set_title(r"$\dot\gamma t \in [5, %g]$" % t_end, fontsize=8)
+                off = [("no bending" if k == "none" else k) for k in left_out]
+                ins.set_title(r"$\dot\gamma t \in [5, %g]$" % t_end
+                              + (" (not shown: " + ", ".join(off) + ")" if off else ""), fontsize=8)
             ax.set_xlabel(r"$\dot\gamma t$")
             ax.set_ylabel("D")
             ax.set_xlim(0, t_end)
-            ax.set_ylim(bottom=0)
+            ax.set_ylim(0, 1.05 * top)
             ax.grid(alpha=0.3)
             ax.legend(loc="upper left", fontsize=8, ncol=2)
             ax.set_title(f"G = {fmt_g(G)}, kB_hat = {fmt_g(kb)}, {n} triangles")
@@ -776,8 +801,15 @@ def section_e(results, runs, fig_dir, rel, t_end, n, meta):
     # Figure 12: no bending, five G.
     runs_a = [r for r in runs if r.method == "none"]
     if runs_a and all(r in results for r in runs_a):
-        lines += demote(section_a(results, runs_a, fig_dir, rel, t_end, suffix),
+        # Beside the table: why its smallest G differs between the resolutions (the runs of
+        # scripts/small_g_study.py, in studies/small_g).
+        small_g = (small_g_study.section(fig_dir, rel)
+                   if n == 5120 and t_end >= 10 and E_QUADRATURE == "tree-mixed" else [])
+        note = (" Without bending the membrane wrinkles at these G, at the mesh's own wavelength, so these "
+                "slopes depend on the mesh; the slope from smooth runs is given below." if small_g else "")
+        lines += demote(section_a(results, runs_a, fig_dir, rel, t_end, suffix, note),
                         f"(e.1) No bending: deformation against shear rate (figure 12), {n} triangles")
+        lines += small_g
 
     # Figure 14: every method at the two cases of the paper.
     none_results = {(n, G): results[r] for r in runs_a if r in results for (G, kb) in PAIRS if close(r.G, G)}
@@ -1081,6 +1113,7 @@ def main():
         sys.exit(f"error: no bendlab binary at '{args.bendlab}' (build it: cmake --preset release && "
                  "cmake --build --preset release, or pass --bendlab PATH)")
     METHODS[:] = bending_methods(bendlab)
+    small_g_study.BENDLAB = bendlab  # writes the meshes its shape pictures need
     work = Path(args.work).resolve()
     doc = Path(args.doc).resolve()
     fig_dir = doc.with_suffix("")
