@@ -30,7 +30,10 @@ PAPER_METHODS = ["A", "B", "C", "D", "E", "S"]
 # Methods beyond the paper: no paper symbol exists for them (Method J: Juelicher 1996, docs/design.md).
 NOT_IN_PAPER = {"ED": "the paper's proposed mixture (E for n, H, K and D's operator for Lap H), not in its tables",
                 "J": "Juelicher's edge-based mean curvature and its energy gradient (Juelicher 1996, compared by "
-                     "Bian et al. 2020); the paper has no Method J"}
+                     "Bian et al. 2020); the paper has no Method J",
+                "M": "Monge jets (../shared/spec/METHOD_M.md): a degree-5 height polynomial fitted on the 3-ring in the "
+                     "chart of the 2-ring's covariance normal gives n, H, K and Lap H from one fit; beyond the paper, "
+                     "its answer to the paper's open problem (no method's maximal error of f converges)"}
 # None: the method does not compute the quantity (empty cell in the paper).
 PAPER_TABLE2 = {
     "max": {
@@ -277,6 +280,48 @@ def extra_section(study, methods):
     return md
 
 
+def max_error_overview_section(study):
+    """The maximal errors of Lap H and f of every method on every refined family, side by side: the slope over
+    the three finest meshes and the error at the finest (the paper's open problem in one table)."""
+    fams = [f for f in ("mt1", "mt2", "octa", "irregular") if any(r["family"] == f for r in study["rates"])]
+    methods = list(study["options"]["methods"])
+    md = ["## The maximal error on every family, side by side
+"]
+    md.append("The paper's central negative result is that no method's *maximal* error of f converges. Each cell: "
+              "the least-squares slope s of log(max error) against log(1/h) over the three finest meshes "
+              "(error ~ h^-s, so s = -2 is second order and s > 0 divergence) and, in brackets, the maximal error "
+              "of eq. (17) at the finest mesh (81920 triangles; octa: its finest). – : not computed by the method.\n")
+    for q in ("lapH", "f"):
+        md.append(f"### Maximal error of {QUANTITY_NAMES[q]}\n")
+        table = []
+        for m in methods:
+            cells = [m]
+            for fam in fams:
+                rate = next((r for r in study["rates"] if r["family"] == fam and r["method"] == m
+                             and r["quantity"] == q and r["measure"] == "max"), None)
+                if rate is None or rate.get("slope_tail") is None:
+                    cells.append("–")
+                else:
+                    cells.append(f"{rate['slope_tail']:+.2f} ({rate['error'][-1]:.2g})")
+            table.append(cells)
+        md.append(md_table(["method"] + [f if f == "irregular" else f.upper() for f in fams], table))
+    conv = []
+    for fam in fams:
+        rate = next((r for r in study["rates"] if r["family"] == fam and r["method"] == "M"
+                     and r["quantity"] == "f" and r["measure"] == "max"), None)
+        if rate is not None and rate.get("slope_tail") is not None:
+            conv.append((fam, rate["slope_tail"], rate["error"][-1]))
+    if conv:
+        worst = max(c[1] for c in conv)
+        largest = max(c[2] for c in conv)
+        md.append(f"\nMethod M's maximal error of f converges on every family: slopes between "
+                  f"{min(c[1] for c in conv):+.2f} and {worst:+.2f} over the three finest meshes (order "
+                  f"{-worst:.1f} or better), at most {largest:.2g} of max|f| on the finest meshes. On the coarsest "
+                  "meshes (320-1280 triangles) the 3-ring covers a large part of the cell, and there E and C are "
+                  "more accurate (see the tables of Method M below).\n")
+    return md
+
+
 def jitter_args(opts):
     """The --jitter and --jitter-seed of a study that ran the irregular family with other than the defaults."""
     if "irregular" not in opts["families"]:
@@ -434,6 +479,8 @@ def main():
 
     if any(m["family"] == "irregular" for m in study["meshes"]):
         md += irregular_section(study, study_dir, extra_dir, extra_methods)
+
+    md += max_error_overview_section(study)
 
     md.append("## Table 3: the inhomogeneous mesh\n")
     beyond = [m for m in study["options"]["methods"] if m in NOT_IN_PAPER]

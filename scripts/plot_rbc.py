@@ -37,7 +37,7 @@ VALUE_COLUMNS = {"H": ("H", "H_exact", "$H$"), "lapH": ("lapH", "lapH_exact", "$
 PLOTTED_FAMILIES = ("mt1", "mt2", "irregular")
 # The family drawn with open markers beside a family, and how the plot's title names it.
 COMPANION = {"mt1": ("octa", "octahedron meshes"), "irregular": ("mt1", "the MT1 meshes before the jitter")}
-MARKERS = {"A": "o", "B": "s", "C": "^", "D": "v", "E": "D", "ED": "P", "S": "X", "J": "h"}
+MARKERS = {"A": "o", "B": "s", "C": "^", "D": "v", "E": "D", "ED": "P", "S": "X", "J": "h", "M": "d"}
 
 
 def read_rows(path):

@@ -140,6 +140,7 @@ METHOD_STYLE = {
     "A": dict(color="tab:blue"), "B": dict(color="tab:orange"), "C": dict(color="tab:green"),
     "D": dict(color="tab:red"), "E": dict(color="tab:purple"), "ED": dict(color="tab:brown", ls="-."),
     "S": dict(color="black", ls=":"), "J": dict(color="tab:olive", ls="--"),
+    "M": dict(color="tab:cyan", ls="-."),
 }
 
 _print_lock = threading.Lock()
