@@ -6,7 +6,7 @@ packages=(
   g++ cmake ninja-build git
   libeigen3-dev libfmt-dev nlohmann-json3-dev libcli11-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  python3 python3-numpy python3-matplotlib python3-dev pybind11-dev python3-pytest
+  python3 python3-numpy python3-scipy python3-matplotlib python3-dev pybind11-dev python3-pytest
   libopenmpi-dev openmpi-bin
 )
 missing=()

@@ -31,6 +31,7 @@ struct ShearArgs {
   double G = 0.1, t_end = 10, snapshot_every = 0.5, rtol = 1e-7, atol = 1e-6;
   std::optional<double> kappa_b_hat, kappa_b;
   int rings = 0;
+  std::vector<std::string> options;  // --option key=value
   std::int64_t stop_after_steps = 0;
   bool resume = false, overwrite = false, plot = true;
   LatticeRunSpec lattice;  // --solver lbm
@@ -68,6 +69,7 @@ void shear(const ShearArgs& a) {
   spec.solver = a.solver;
   spec.method = a.method;
   if (a.rings != 0) spec.method_options["rings"] = std::to_string(a.rings);
+  add_option_assignments(spec.method_options, a.options);
   spec.mesh = a.mesh;
   spec.G = a.G;
   spec.kappa_b_hat = a.kappa_b_hat;
@@ -122,6 +124,9 @@ const CommandRegistration registration([](CLI::App& app) {
   cmd->add_option("--method", args->method, "bending method: none, " + method_names_joined())
       ->check(CLI::IsMember(method_choices_with_none()))->capture_default_str();
   cmd->add_option("--rings", args->rings, "fitting support of E and ED (1, 2, 3)")->check(CLI::Range(1, 3));
+  cmd->add_option("--option", args->options, "method option key=value, repeatable (the options of each method: "
+                                             "bendlab methods), e.g. --option degree=6 for M; part of the run's "
+                                             "identity on --resume");
   cmd->add_option("--mesh", args->mesh, "mt1:N or mt2:N (N triangles: 320, 1280, 5120, ...), inh:mt1 or inh:mt2 "
                                         "(320 triangles + 3 Rivara passes), or a mesh file (.off, .obj, .ply)")
       ->capture_default_str();

@@ -36,53 +36,10 @@ MongeJetFit invalid_fit(int points) {
   return f;
 }
 
-/// Cholesky factorisation of an n x n symmetric positive definite matrix (lower triangle read),
-/// with the pivot test above; the loops have compile-time bounds so that they unroll.
-template <int P>
-class Cholesky {
- public:
-  using Mat = Eigen::Matrix<double, P, P>;
-  using Vec = Eigen::Matrix<double, P, 1>;
-  bool compute(const Mat& a) {
-    const double max_diag = a.diagonal().maxCoeff();
-    for (int j = 0; j < P; ++j) {
-      double d = a(j, j);
-      for (int k = 0; k < j; ++k) d -= l_(j, k) * l_(j, k);
-      if (!(d > kMinPivotRatio * max_diag)) return false;
-      const double ljj = std::sqrt(d);
-      l_(j, j) = ljj;
-      inv_diag_[j] = 1.0 / ljj;
-      for (int i = j + 1; i < P; ++i) {
-        double v = a(i, j);
-        for (int k = 0; k < j; ++k) v -= l_(i, k) * l_(j, k);
-        l_(i, j) = v * inv_diag_[j];
-      }
-    }
-    return true;
-  }
-  Vec solve(const Vec& b) const {
-    Vec y;
-    for (int i = 0; i < P; ++i) {
-      double v = b[i];
-      for (int k = 0; k < i; ++k) v -= l_(i, k) * y[k];
-      y[i] = v * inv_diag_[i];
-    }
-    for (int i = P - 1; i >= 0; --i) {
-      double v = y[i];
-      for (int k = i + 1; k < P; ++k) v -= l_(k, i) * y[k];
-      y[i] = v * inv_diag_[i];
-    }
-    return y;
-  }
-
- private:
-  Mat l_;
-  Vec inv_diag_;
-};
-
 /// The fit of METHOD_M.md steps 3-5 for a jet of degree D.
 template <int D>
-MongeJetFit fit_jet(const Vec3& x0, const Vec3& n0_in, std::span<const Vec3> support, bool gaussian_weights) {
+MongeJetFit fit_jet(const Vec3& x0, const Vec3& n0_in, std::span<const Vec3> support, bool gaussian_weights,
+                   Accumulation accumulation) {
   constexpr int P = unknowns_of(D);
   using Mat = Eigen::Matrix<double, P, P>;
   using Vec = Eigen::Matrix<double, P, 1>;
@@ -108,23 +65,52 @@ MongeJetFit fit_jet(const Vec3& x0, const Vec3& n0_in, std::span<const Vec3> sup
   if (!(fit.scale > 0)) return invalid_fit(m);
   const double inv_s = 1.0 / fit.scale;
 
-  // Normal equations of the scaled least-squares problem.
-  Mat a = Mat::Zero();
+  // Normal equations of the scaled least-squares problem. Entry ((a,b), (c,d)) of Phi^T W Phi is the
+  // moment mu_{a+c, b+d} = sum_j w_j xi_j^(a+c) eta_j^(b+d), so the fast path sums the
+  // (2D+1)(2D+2)/2 moments per point (91 for degree 6) instead of the P^2 products of an outer
+  // product (729), and fills the matrix from them; the reference path sums the outer products.
+  Mat a;
   Vec rhs = Vec::Zero();
-  for (int j = 0; j < m; ++j) {
-    const double xi = uvw[j][0] * inv_s, eta = uvw[j][1] * inv_s;
-    std::array<double, D + 1> pu, pv;
-    pu[0] = pv[0] = 1;
-    for (int k = 1; k <= D; ++k) pu[k] = pu[k - 1] * xi, pv[k] = pv[k - 1] * eta;
-    Vec phi;
-    for (int k = 1; k <= D; ++k)
-      for (int b = 0; b <= k; ++b) phi[monomial_index(k - b, b)] = pu[k - b] * pv[b];
-    const double w = gaussian_weights ? std::exp(-0.5 * (xi * xi + eta * eta)) : 1.0;
-    a.noalias() += (w * phi) * phi.transpose();
-    rhs += (w * uvw[j][2]) * phi;
+  if (accumulation == Accumulation::Moments) {
+    std::array<double, (2 * D + 1) * (2 * D + 1)> mu{};  // mu[p * (2D+1) + q], p + q <= 2D used
+    for (int j = 0; j < m; ++j) {
+      const double xi = uvw[j][0] * inv_s, eta = uvw[j][1] * inv_s;
+      const double w = gaussian_weights ? std::exp(-0.5 * (xi * xi + eta * eta)) : 1.0;
+      std::array<double, 2 * D + 1> pu, pv;
+      pu[0] = w, pv[0] = 1;
+      for (int k = 1; k <= 2 * D; ++k) pu[k] = pu[k - 1] * xi, pv[k] = pv[k - 1] * eta;
+      for (int p = 0; p <= 2 * D; ++p)
+        for (int q = 0; p + q <= 2 * D; ++q) mu[p * (2 * D + 1) + q] += pu[p] * pv[q];
+      const double hw = uvw[j][2];
+      for (int k = 1; k <= D; ++k)
+        for (int b = 0; b <= k; ++b) rhs[monomial_index(k - b, b)] += hw * pu[k - b] * pv[b];
+    }
+    for (int k1 = 1; k1 <= D; ++k1)
+      for (int b1 = 0; b1 <= k1; ++b1)
+        for (int k2 = 1; k2 <= D; ++k2)
+          for (int b2 = 0; b2 <= k2; ++b2)
+            a(monomial_index(k1 - b1, b1), monomial_index(k2 - b2, b2)) =
+                mu[(k1 - b1 + k2 - b2) * (2 * D + 1) + b1 + b2];
+  } else {
+    a.setZero();
+    for (int j = 0; j < m; ++j) {
+      const double xi = uvw[j][0] * inv_s, eta = uvw[j][1] * inv_s;
+      std::array<double, D + 1> pu, pv;
+      pu[0] = pv[0] = 1;
+      for (int k = 1; k <= D; ++k) pu[k] = pu[k - 1] * xi, pv[k] = pv[k - 1] * eta;
+      Vec phi;
+      for (int k = 1; k <= D; ++k)
+        for (int b = 0; b <= k; ++b) phi[monomial_index(k - b, b)] = pu[k - b] * pv[b];
+      const double w = gaussian_weights ? std::exp(-0.5 * (xi * xi + eta * eta)) : 1.0;
+      a.noalias() += (w * phi) * phi.transpose();
+      rhs += (w * uvw[j][2]) * phi;
+    }
   }
-  Cholesky<P> llt;
-  if (!llt.compute(a)) return invalid_fit(m);
+  // Eigen's blocked Cholesky (vectorised), then the pivot test on the factor's diagonal.
+  const Eigen::LLT<Mat> llt(a);
+  if (llt.info() != Eigen::Success) return invalid_fit(m);
+  const double max_diag = a.diagonal().maxCoeff();
+  if (!(llt.matrixLLT().diagonal().cwiseAbs2().minCoeff() > kMinPivotRatio * max_diag)) return invalid_fit(m);
   const Vec c = llt.solve(rhs);
 
   // d^a_u d^b_v h(0) = a! b! c_ab / s^(a+b), orders 1 to 4 (zero above the jet's degree).
@@ -180,11 +166,11 @@ Vec3 covariance_normal(const Vec3& x0, std::span<const Vec3> points, const Vec3&
 }
 
 MongeJetFit monge_jet_fit_point(const Vec3& x0, const Vec3& n0, std::span<const Vec3> support, int degree,
-                                bool gaussian_weights) {
+                                bool gaussian_weights, Accumulation accumulation) {
   switch (degree) {
-    case 4: return fit_jet<4>(x0, n0, support, gaussian_weights);
-    case 5: return fit_jet<5>(x0, n0, support, gaussian_weights);
-    case 6: return fit_jet<6>(x0, n0, support, gaussian_weights);
+    case 4: return fit_jet<4>(x0, n0, support, gaussian_weights, accumulation);
+    case 5: return fit_jet<5>(x0, n0, support, gaussian_weights, accumulation);
+    case 6: return fit_jet<6>(x0, n0, support, gaussian_weights, accumulation);
     default: throw Error(fmt::format("method M: degree must be 4, 5 or 6, got {}", degree));
   }
 }
@@ -249,8 +235,8 @@ std::unique_ptr<BendingMethod> MongeJetMethod::create(const MethodOptions& optio
 
 MethodInfo MongeJetMethod::info() {
   MethodInfo m{"M",
-               "Monge jet: degree-5 height fit on the 3-ring gives n, H, K and Lap H in eq. (10) (beyond the paper)",
-               {int_option("degree", 4, 6, 5, "degree of the fitted height polynomial (4, 5 or 6)"),
+               "Monge jet: degree-6 height fit on the 3-ring gives n, H, K and Lap H in eq. (10) (beyond the paper)",
+               {int_option("degree", 4, 6, 6, "degree of the fitted height polynomial (4, 5 or 6)"),
                 int_option("support_rings", 2, 3, 3,
                            "fitting support in rings of neighbours (widened while it has fewer than "
                            "unknowns + 4 points or the fit is singular)"),

@@ -87,7 +87,8 @@ TEST(MethodRegistry, ListsTheBuiltInsInTableOrder) {
 }
 
 TEST(MethodRegistry, CapabilitiesMatchWhatTheMethodsCompute) {
-  const TriMesh m = sphere_mesh(MeshFamily::MT1, 1);
+  // 320 triangles: on 80, Method M's degree-6 jet is not determined even by the whole sphere.
+  const TriMesh m = sphere_mesh(MeshFamily::MT1, 2);
   for (const MethodInfo& info : bending_methods()) {
     const BendingResult r = make_bending_method(info.name)->compute(m.topology(), m.positions(), 1.0);
     const MethodCapabilities& c = info.capabilities;

@@ -146,12 +146,12 @@ BendingResult method_m(const Points& x, const Topology& t, const MethodOptions& 
 }
 
 /// Max error of f over the nodes relative to max|f| (eq. (17)) of Method M on the RBC.
-double rbc_max_error_f(const TriMesh& sphere, const Mat3& rotation = Mat3::Identity()) {
+double rbc_max_error_f(const TriMesh& sphere, const Mat3& rotation, const MethodOptions& options) {
   const auto rbc = make_rbc();
   Points on_sphere = sphere.positions() * rotation.transpose();
   const Points x = rbc->map_from_unit_sphere(on_sphere);
   const SurfaceFields exact = rbc->evaluate(x);
-  const BendingResult r = method_m(x, sphere.topology());
+  const BendingResult r = method_m(x, sphere.topology(), options);
   double e = 0;
   for (Eigen::Index i = 0; i < x.rows(); ++i) e = std::max(e, (exact.f.row(i) - r.force_density.row(i)).norm());
   return e / rbc->maxima().f;
@@ -226,6 +226,27 @@ TEST(MongeJetFit, DegreeSixIsExactOnDegreeFiveAndDegreeFourIsNot) {
   EXPECT_GT(std::abs(four.lapH - g.lap_divergence_form(0.1, 0.2)), 1e-4);
 }
 
+TEST(MongeJetFit, MomentSumsEqualTheOuterProductReference) {
+  // The fast path (normal matrix from the support's moments) against the plain sum of outer products,
+  // on a support off any polynomial, every degree, with and without weights.
+  std::mt19937 gen(21);
+  std::normal_distribution<double> noise(0, 2e-3);
+  const PolynomialGraph g(6);
+  std::vector<Vec3> support = graph_support(g, 0.05, -0.1, 36, 0.15, 4);
+  for (Vec3& p : support) p += Vec3(noise(gen), noise(gen), noise(gen));
+  const Vec3 x0 = g.point(0.05, -0.1), n0 = (g.q * Vec3(0.05, 0.02, 1)).normalized();
+  for (const int degree : {4, 5, 6})
+    for (const bool weights : {false, true}) {
+      const MongeJetFit fast = monge_jet_fit_point(x0, n0, support, degree, weights, Accumulation::Moments);
+      const MongeJetFit ref = monge_jet_fit_point(x0, n0, support, degree, weights, Accumulation::OuterProducts);
+      ASSERT_TRUE(fast.valid && ref.valid);
+      EXPECT_NEAR(fast.H, ref.H, 1e-10 * std::abs(ref.H)) << degree;
+      EXPECT_NEAR(fast.K, ref.K, 1e-9 * std::abs(ref.K)) << degree;
+      EXPECT_NEAR(fast.lapH, ref.lapH, 1e-8 * (1 + std::abs(ref.lapH))) << degree;
+      EXPECT_NEAR((fast.normal - ref.normal).norm(), 0.0, 1e-12) << degree;
+    }
+}
+
 TEST(MongeJetFit, TooFewOrDegeneratePointsAreInvalid) {
   const PolynomialGraph g(5);
   const std::vector<Vec3> few = graph_support(g, 0, 0, 19, 0.15, 3);  // 20 unknowns
@@ -245,14 +266,14 @@ TEST(MongeJet, RegistryEntryAndOptions) {
   EXPECT_EQ(make_bending_method("M")->name(), "M");
   const auto defaults = make_bending_method("M");
   const MongeJetSettings& s = dynamic_cast<const MongeJetMethod&>(*defaults).settings();
-  EXPECT_EQ(s.degree, 5);
+  EXPECT_EQ(s.degree, 6);
   EXPECT_EQ(s.rings, 3);
   EXPECT_EQ(s.frame, MongeFrame::Covariance);
   EXPECT_FALSE(s.gaussian_weights);
   const auto chosen = make_bending_method(
-      "M", {{"degree", "6"}, {"support_rings", "2"}, {"frame", "angle-weighted"}, {"gaussian_weights", "true"}});
+      "M", {{"degree", "5"}, {"support_rings", "2"}, {"frame", "angle-weighted"}, {"gaussian_weights", "true"}});
   const MongeJetSettings& t = dynamic_cast<const MongeJetMethod&>(*chosen).settings();
-  EXPECT_EQ(t.degree, 6);
+  EXPECT_EQ(t.degree, 5);
   EXPECT_EQ(t.rings, 2);
   EXPECT_EQ(t.frame, MongeFrame::AngleWeighted);
   EXPECT_TRUE(t.gaussian_weights);
@@ -262,7 +283,7 @@ TEST(MongeJet, RegistryEntryAndOptions) {
 }
 
 TEST(MongeJet, RefusesAMeshTooSmallForTheJetNamingTheVertex) {
-  const TriMesh ico = icosahedron();  // 11 other vertices, 20 unknowns
+  const TriMesh ico = icosahedron();  // 11 other vertices, 27 unknowns (degree 6)
   try {
     method_m(ico.positions(), ico.topology());
     FAIL() << "no error";
@@ -270,7 +291,7 @@ TEST(MongeJet, RefusesAMeshTooSmallForTheJetNamingTheVertex) {
     const std::string what = e.what();
     EXPECT_NE(what.find("method M"), std::string::npos) << what;
     EXPECT_NE(what.find("vertex 0"), std::string::npos) << what;
-    EXPECT_NE(what.find("20 unknowns"), std::string::npos) << what;
+    EXPECT_NE(what.find("27 unknowns"), std::string::npos) << what;
   }
   // Degree 4 (14 unknowns) still needs 14 points: refused too, at 11.
   EXPECT_THROW(method_m(ico.positions(), ico.topology(), {{"degree", "4"}}), Error);
@@ -343,14 +364,23 @@ TEST(MongeJet, RbcMaximumErrorOfFConvergesAtSecondOrder) {
     MeshFamily family;
     int first_level;
     Mat3 rotation;
+    MethodOptions options;
   };
-  for (const Case& c : {Case{MeshFamily::MT1, 4, Mat3::Identity()}, Case{MeshFamily::MT2, 4, Mat3::Identity()},
-                        Case{MeshFamily::Octa, 5, Mat3::Identity()}, Case{MeshFamily::Irregular, 4, Mat3::Identity()},
-                        Case{MeshFamily::MT1, 4, random_rotation}, Case{MeshFamily::Irregular, 4, random_rotation}}) {
+  std::vector<Case> cases;
+  // The default (degree 6) and the spec's degree 5.
+  for (const MethodOptions& options : {MethodOptions{}, MethodOptions{{"degree", "5"}}})
+    for (const Case& c : {Case{MeshFamily::MT1, 4, Mat3::Identity(), options},
+                          Case{MeshFamily::MT2, 4, Mat3::Identity(), options},
+                          Case{MeshFamily::Octa, 5, Mat3::Identity(), options},
+                          Case{MeshFamily::Irregular, 4, Mat3::Identity(), options},
+                          Case{MeshFamily::MT1, 4, random_rotation, options},
+                          Case{MeshFamily::Irregular, 4, random_rotation, options}})
+      cases.push_back(c);
+  for (const Case& c : cases) {
     std::vector<double> err, h;
     for (int level = c.first_level; level < c.first_level + 3; ++level) {
       const TriMesh m = sphere_mesh(c.family, level);
-      err.push_back(rbc_max_error_f(m, c.rotation));
+      err.push_back(rbc_max_error_f(m, c.rotation, c.options));
       h.push_back(1.0 / std::sqrt(double(m.num_faces())));
     }
     // Least-squares slope of log(err) against log(1/h).
@@ -361,8 +391,9 @@ TEST(MongeJet, RbcMaximumErrorOfFConvergesAtSecondOrder) {
     }
     const double n = static_cast<double>(err.size());
     const double slope = (n * sxy - sx * sy) / (n * sxx - sx * sx);
-    std::printf("M max err f, %s: %.3e %.3e %.3e, slope %.2f\n", to_string(c.family).c_str(), err[0], err[1],
-                err[2], slope);
+    const std::string degree = c.options.empty() ? "default" : c.options.at("degree");
+    std::printf("M (degree %s) max err f, %s: %.3e %.3e %.3e, slope %.2f\n", degree.c_str(),
+                to_string(c.family).c_str(), err[0], err[1], err[2], slope);
     EXPECT_LE(slope, -1.5) << to_string(c.family);
     EXPECT_LT(err.back(), 2e-2) << to_string(c.family);
   }

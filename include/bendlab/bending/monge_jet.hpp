@@ -1,6 +1,6 @@
 #pragma once
 // Method M (Monge jet; ../shared/spec/METHOD_M.md): at every node a least-squares height function
-// of degree 5 (default) over the vertices within 3 edge-rings gives the normal, H, K and Lap_S H of
+// of degree 6 (default; 4 and 5 as options) over the vertices within 3 edge-rings gives the normal, H, K and Lap_S H of
 // the fitted graph (graph_curvature.hpp), and then the force density of eq. (10),
 //   f = 2 kB (Lap H + 2 H (H^2 - K)) n,    F = f A_mixed (eq. (14)), as for C and E.
 // Unlike E, which fits a paraboloid and then a second paraboloid to the fitted H, M takes Lap H from
@@ -18,6 +18,17 @@
 //    constant term, the surface passes through x_i.
 // 4. Height derivatives at the node: d^a_u d^b_v h = a! b! c_ab / s^(a+b), orders 1 to 4.
 // 5. n, H, K, Lap_S H of the graph (graph_curvature.hpp); n is turned into world coordinates.
+//
+// Why degree 6 and not the spec's 5: a degree-5 jet's 4th derivatives carry an O(h^2) truncation
+// error fed by the surface's 6th-order Taylor terms, which the symmetric supports of the regular
+// families do not cancel. On the unit sphere at 5120 triangles it gives Lap H = +0.15 everywhere
+// (C: 1e-6), a bias of 10 % of the force of a capsule in shear at G = 0.05, whose D_steady came out
+// 3 % above C's, E's, J's and S's; at G = 0.2, kB_hat = 0.15 the degree-5 capsule became unstable
+// at gamma t = 0.9 (5120 triangles) and 1.5 (1280), with RKC and with Cash-Karp alike. Degree 6 fits
+// the 6th-order terms; the error left comes from the odd 7th-order terms, which such supports
+// largely cancel: on the RBC its maximal error of f at 81920 triangles is 2e-4 (MT1), 1.3e-3
+// (irregular), 2e-4 (octahedron, 131072) against degree 5's 8e-3 to 1e-2, it is also the more
+// accurate from 5120 triangles on, and the capsule runs are stable (docs/results/shear.md).
 #include <memory>
 #include <span>
 #include <string>
@@ -34,7 +45,7 @@ namespace bendlab {
 enum class MongeFrame { Covariance, AngleWeighted };
 
 struct MongeJetSettings {
-  int degree = 5;                          ///< 4, 5 or 6
+  int degree = 6;                          ///< 4, 5 or 6 (default 6: see the header comment)
   int rings = 3;                           ///< 2 or 3: the support before any widening
   MongeFrame frame = MongeFrame::Covariance;
   bool gaussian_weights = false;
@@ -61,11 +72,15 @@ struct MongeJetFit {
 /// signed so that its dot product with `orientation` is not negative.
 Vec3 covariance_normal(const Vec3& x0, std::span<const Vec3> points, const Vec3& orientation);
 
+/// How the normal matrix of the fit is summed: from the support's moments sum w xi^p eta^q (the fast
+/// path, used by the method) or as the sum of outer products phi phi^T (the plain reference).
+enum class Accumulation { Moments, OuterProducts };
+
 /// Steps 3-5 at one node: the jet of `degree` fitted to `support` (positions, the node excluded) in
 /// the chart of unit normal n0. Invalid (valid = false) when there are fewer points than unknowns,
 /// or the normal matrix is numerically singular.
 MongeJetFit monge_jet_fit_point(const Vec3& x0, const Vec3& n0, std::span<const Vec3> support, int degree,
-                                bool gaussian_weights = false);
+                                bool gaussian_weights = false, Accumulation accumulation = Accumulation::Moments);
 
 /// The fit at every node, with the support rule of step 2 (rings widened where needed). Throws
 /// bendlab::Error naming the method and the first vertex that cannot be fitted (too few vertices in
