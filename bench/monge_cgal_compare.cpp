@@ -13,10 +13,12 @@
 // and on stderr a check that the supports are those of monge_jet_fit (M's degree-5 H and K per
 // node equal monge_jet_fit's bit for bit).
 //
-// The supports: for every vertex the vertices monge_jet_fit uses for the default degree-5 fit
+// The supports: for every vertex the vertices monge_jet_fit uses for a degree-5 fit
 // (3-ring, widened ring by ring to at least 24 points or until the fit is regular; the ring count
 // is read back from monge_jet_fit). Every fit gets the same points:
-//   M5, M4      monge_jet_fit_point, degree 5 / 4, chart normal = covariance normal of the 2-ring
+//   M5, M4, M6  monge_jet_fit_point, degree 5 / 4 / 6 on the degree-5 supports, chart normal =
+//               covariance normal of the 2-ring (M6: the method's default degree; the method itself
+//               widens supports of fewer than 31 points)
 //               signed by the angle-weighted normal (METHOD_M.md step 1); the node is the origin
 //               and the jet has no constant term.
 //   CGAL4, CGAL5  Monge_via_jet_fitting(d_fitting = 4 / 5, d_monge = 4) on the node followed by the
@@ -177,7 +179,7 @@ int main(int argc, char** argv) {
         const SurfaceFields exact = rbc->evaluate(x);
 
         // The supports monge_jet_fit uses (its ring counts), and its own H, K for the check below.
-        const std::vector<MongeJetFit> reference = monge_jet_fit(t, x, geometry.normal_mwa, MongeJetSettings{});
+        const std::vector<MongeJetFit> reference = monge_jet_fit(t, x, geometry.normal_mwa, MongeJetSettings{.degree = 5});
         const Supports s = gather_supports(t, x, reference);
         auto support = [&](int i) {
           return std::span<const Vec3>(s.points.data() + s.begin[i], s.begin[i + 1] - s.begin[i]);
@@ -219,6 +221,7 @@ int main(int argc, char** argv) {
         std::vector<Named> runs;
         runs.push_back({"M5", run_fit(n, repeats, method_m(5))});
         runs.push_back({"M4", run_fit(n, repeats, method_m(4))});
+        runs.push_back({"M6", run_fit(n, repeats, method_m(6))});
         runs.push_back({"CGAL4", run_fit(n, repeats, cgal(4))});
         runs.push_back({"CGAL5", run_fit(n, repeats, cgal(5))});
 
