@@ -321,6 +321,24 @@ TEST_F(Cli, ShearRefusesBadParametersBeforeWork) {
   expect_refused(run("shear --resume --out " + out.string()), "checkpoint", out);
 }
 
+TEST_F(Cli, ShearTakesMethodOptionsAsPartOfTheRunsIdentity) {
+  const fs::path out = dir / "run";
+  expect_refused(run("shear --method C --kappa-b-hat 0.1 --option degree=5 --out " + out.string()), "degree", out);
+  expect_refused(run("shear --method M --kappa-b-hat 0.1 --option degree=9 --out " + out.string()), "degree", out);
+  expect_refused(run("shear --method M --kappa-b-hat 0.1 --option degree --out " + out.string()), "key=value", out);
+  const std::string common = "shear --method M --mesh mt1:320 --G 0.1 --kappa-b-hat 0.1 --no-plot --out " + out.string();
+  CliRun r = run(common + " --option degree=4 --t-end 0.02");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto summary = nlohmann::json::parse(slurp(out / "summary.json"));
+  EXPECT_EQ(summary.at("method_options").at("degree"), "4");
+  // A resume with another degree is another run: refused.
+  r = run(common + " --option degree=5 --t-end 0.04 --resume");
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.err.find("degree"), std::string::npos) << r.err;
+  r = run(common + " --option degree=4 --t-end 0.04 --resume");
+  EXPECT_EQ(r.status, 0) << r.err;
+}
+
 TEST_F(Cli, ShearWritesItsFilesAndResumes) {
   const fs::path out = dir / "run";
   CliRun r = run("shear --mesh mt1:320 --G 0.1 --t-end 0.3 --snapshot-every 0.1 --no-plot --out " + out.string());
