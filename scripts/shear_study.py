@@ -14,7 +14,7 @@ Writes docs/results/shear.md and the PNGs it shows (docs/results/shear/):
   (a) no bending, 1280 triangles, G = 0.0125 ... 0.2: D against gamma t (figure 12a) and the
       steady D against G (figure 12b) with the small-G slope, small-deformation theory and the
       published values at G = 0.1;
-  (b) every registered method (A, B, C, D, E, ED, S) at 320 and 1280 triangles for (G, kB_hat) = (0.05, 0.0375) and
+  (b) every registered method (A, B, C, D, E, ED, S, J, M) at 320 and 1280 triangles for (G, kB_hat) = (0.05, 0.0375) and
       (0.2, 0.15): D against gamma t, all methods in one plot per pair and resolution (figures 13
       and 14);
   (c) the average gamma dt over gamma t in [5, 10] (table 4) beside the paper's values, and the
@@ -25,7 +25,7 @@ Writes docs/results/shear.md and the PNGs it shows (docs/results/shear/):
       (every registered method at both (G, kB_hat) pairs), table 4 (the paper's Cash-Karp mean
       gamma dt beside RKC's mean step, BIM evaluations and stages), figure 16 (C and S at G = 0.05,
       kB_hat = 0.0375), figure 17 (A and C at kB_hat = 2/15, G = 0.05 and 0.2) and the study's wall
-      time. 5 + 2 x (number of methods) + 4 runs (25 with A, B, C, D, E, ED, S, J). The paper gives
+      time. 5 + 2 x (number of methods) + 4 runs (27 with A, B, C, D, E, ED, S, J, M). The paper gives
       the literature values of figures 16 and 17 only as plots, so they are not drawn. Beside
       figure 12's table, the runs of scripts/small_g_study.py (studies/small_g) that explain its
       smallest G (wrinkles without bending), where they have been run.
