@@ -32,7 +32,7 @@ struct ShearArgs {
   std::optional<double> kappa_b_hat, kappa_b;
   int rings = 0;
   std::vector<std::string> options;  // --option key=value
-  std::int64_t stop_after_steps = 0;
+  std::int64_t stop_after_steps = 0, max_steps = 0;
   bool resume = false, overwrite = false, plot = true;
   LatticeRunSpec lattice;  // --solver lbm
   // Which options the user gave (the other solver's options are refused).
@@ -57,6 +57,8 @@ void shear(const ShearArgs& a) {
   if (a.solver == "lbm" && a.given_tolerance)
     throw Error("--integrator, --rtol, --atol and --bim-quadrature are for --solver bim: the lattice Boltzmann "
                 "solver takes fixed steps");
+  if (a.solver == "lbm" && a.max_steps > 0)
+    throw Error("--max-steps is for --solver bim: the lattice Boltzmann solver's step count is fixed by --t-end");
   if (a.solver == "bim" && a.given_lattice)
     throw Error("--radius-lu, --box, --tau, --reynolds, --kernel, --sample-every and --offset are for --solver lbm");
   ShearRunSpec spec;
@@ -81,6 +83,7 @@ void shear(const ShearArgs& a) {
   spec.resume = a.resume;
   spec.overwrite = a.overwrite;
   spec.stop_after_steps = a.stop_after_steps;
+  spec.max_steps = a.max_steps;
   ShearRunCallbacks callbacks;
   callbacks.on_note = note;
   callbacks.on_progress = [](const CapsuleProgress& p) {
@@ -194,6 +197,11 @@ const CommandRegistration registration([](CLI::App& app) {
   cmd->add_option("--stop-after-steps", args->stop_after_steps,
                   "stop after this many accepted steps (no summary; continue with --resume)")
       ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--max-steps", args->max_steps,
+                  "fail the run (its last checkpoint kept) at its accepted step N + 1, counted over all its parts "
+                  "(--resume included): a budget for a step size that collapses as a shape goes "
+                  "unstable; 0: none (bim)")
+      ->check(CLI::NonNegativeNumber)->capture_default_str();
   cmd->add_flag("!--no-plot", args->plot, "do not draw D_theta.png");
   cmd->add_option("--plot-script", args->plot_script,
                   "plot_shear.py to draw D_theta.png with (default: found beside the executable)");

@@ -80,6 +80,7 @@ void check_options(const CapsuleRunOptions& o) {
   if (!(o.snapshot_every > 0) || !std::isfinite(o.snapshot_every))
     throw Error(fmt::format("capsule run: snapshot_every must be positive, got {}", o.snapshot_every));
   if (o.stop_after_steps < 0) throw Error("capsule run: stop_after_steps must be >= 0");
+  if (o.max_steps < 0) throw Error("capsule run: max_steps must be >= 0");
   if (!o.arguments.is_object() || !o.summary_fields.is_object())
     throw Error("capsule run: arguments and summary_fields must be JSON objects");
   if (fs::exists(o.folder) && !fs::is_directory(o.folder))
@@ -305,6 +306,11 @@ CapsuleRunResult run_capsule(CapsuleSolver& solver, const CapsuleRunOptions& o) 
   // keeps the rows of the accepted steps (a resume truncates them to the checkpoint's).
   try {
     solver.advance(o.t_end, [&](const AcceptedStep& s) {
+      // Before the step is counted: a step over the budget leaves no row and no checkpoint.
+      if (o.max_steps > 0 && state.steps >= o.max_steps)
+        throw Error(fmt::format("more than {} accepted steps (the budget of --max-steps) to reach gamma t = {:g} "
+                                "(mean gamma dt {:.3g}; the last step {:.3g})",
+                                o.max_steps, o.t_end, s.time / static_cast<double>(state.steps + 1), s.dt));
       ++state.steps;
       ++steps_here;
       last_good_time = s.time;

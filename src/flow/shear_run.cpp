@@ -89,6 +89,7 @@ CapsuleRunResult run_shear(const ShearRunSpec& a, const ShearRunCallbacks& callb
   const SingleLayerQuadrature quadrature = single_layer_quadrature(a.bim_quadrature);
   if (a.solver != "bim" && a.bim_quadrature != "all7") throw Error("--bim-quadrature is for --solver bim");
   if (a.stop_after_steps < 0) throw Error("--stop-after-steps must be >= 0");
+  if (a.max_steps < 0) throw Error("--max-steps must be >= 0");
   const ShearUnits units = ShearUnits::from(a.G, a.kappa_b_hat, a.kappa_b);
   if (a.method == "none" && units.kappa_b_hat > 0)
     throw Error("--kappa-b-hat or --kappa-b > 0 needs a bending --method (" + method_list() + ")");
@@ -205,6 +206,7 @@ CapsuleRunResult run_shear(const ShearRunSpec& a, const ShearRunCallbacks& callb
   o.resume = a.resume;
   o.overwrite = a.overwrite;
   o.stop_after_steps = a.stop_after_steps;
+  o.max_steps = a.max_steps;
   // The run's identity (checked on resume): every option given; "rings" also on its own, as the
   // command line has always recorded it (the value given, 0 for the method's default).
   const auto rings = a.method_options.find("rings");

@@ -432,6 +432,32 @@ TEST_F(Cli, ShearStoppedAndResumedEqualsUninterrupted) {
   EXPECT_EQ(a, b);
 }
 
+TEST_F(Cli, ShearMaxStepsFailsARunThatExceedsItsBudgetAndKeepsTheCheckpoint) {
+  // The budget counts the accepted steps of all parts: a run that needs N steps passes with the
+  // budget N and fails with N - 1; a resume of a run that spent its budget fails at its first step.
+  const std::string common = " --mesh mt1:320 --G 0.1 --t-end 0.3 --snapshot-every 0.02 --no-plot --out ";
+  const fs::path full = dir / "full", capped = dir / "capped";
+  CliRun r = run("shear" + common + full.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto steps = nlohmann::json::parse(slurp(full / "summary.json")).at("steps").get<std::int64_t>();
+  ASSERT_GT(steps, 3);
+  r = run("shear --max-steps " + std::to_string(steps) + common + (dir / "exact").string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  r = run("shear --max-steps " + std::to_string(steps - 1) + common + capped.string());
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.err.find("more than " + std::to_string(steps - 1) + " accepted steps (the budget of --max-steps)"),
+            std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(capped / "summary.json"));
+  ASSERT_TRUE(fs::exists(capped / "checkpoint.json"));
+  r = run("shear --resume --max-steps " + std::to_string(steps - 1) + common + capped.string());
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.err.find("--max-steps"), std::string::npos) << r.err;
+  r = run("shear --resume" + common + capped.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(slurp(capped / "timeseries.csv"), slurp(full / "timeseries.csv"));
+  expect_refused(run("shear --solver lbm --max-steps 10 --out " + (dir / "lbm").string()), "--max-steps", dir / "lbm");
+}
+
 TEST_F(Cli, ShearRkcStoppedAndResumedEqualsUninterrupted) {
   // The stiff case (Method C, kappa_b_hat = 0.15) with the Runge-Kutta-Chebyshev integrator: its
   // controller memory and spectral radius travel in the checkpoint, so the resumed run repeats the

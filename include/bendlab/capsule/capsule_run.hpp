@@ -64,6 +64,10 @@ struct CapsuleRunOptions {
   /// Stop (without a summary) after this many accepted steps of this part; 0: never. The run can
   /// then be resumed from its last checkpoint (how tests interrupt a run).
   std::int64_t stop_after_steps = 0;
+  /// The run fails (an Error naming the budget, the last checkpoint kept) at its accepted step
+  /// max_steps + 1, counted over all its parts; 0: no budget. A step size that
+  /// collapses without reaching dt_min (a shape going unstable) would otherwise crawl for days.
+  std::int64_t max_steps = 0;
   /// Asked after every accepted step; true stops the run as stop_after_steps does (no summary;
   /// resumable from the last checkpoint). How an interactive caller (Ctrl-C in Python) stops.
   std::function<bool()> should_stop;

@@ -52,6 +52,7 @@ struct ShearRunSpec {
   bool resume = false;                 ///< continue from folder/checkpoint.json
   bool overwrite = false;              ///< a new run may replace another run's files in folder (CapsuleRunOptions)
   std::int64_t stop_after_steps = 0;   ///< stop (resumable) after this many steps; 0: never
+  std::int64_t max_steps = 0;          ///< fail after this many accepted steps in all parts; 0: no budget
 };
 
 struct ShearRunCallbacks {
