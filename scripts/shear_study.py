@@ -101,6 +101,11 @@ E_INTEGRATOR = "rkc"
 # name ends in _tree and its summary.json must name the quadrature.
 E_QUADRATURE = "all7"
 RTOL, ATOL = "1e-7", "1e-6"
+# A run fails once it takes more accepted steps than this: 8 times the most any run of the paper's
+# cases needs (24402, C at 5120 triangles by Cash-Karp); a shape that goes unstable makes its step
+# collapse to 1e-10 and would crawl on for days. Such a failure is recorded in the run's folder
+# (failed.json) and reported, not retried: delete the folder to run it again.
+MAX_STEPS = 200_000
 FIG16_METHODS = ["C", "S"]  # figure 16: G = 0.05, kB_hat = 0.0375 (runs of figure 14)
 FIG17_KB = 2.0 / 15.0  # figure 17: Methods A and C at kB_hat = 2/15, G = 0.05 and 0.2
 FIG17_G = [0.05, 0.2]
@@ -208,7 +213,7 @@ class Run:
             args += ["--integrator", self.integrator, "--rtol", RTOL, "--atol", ATOL]
         if self.quadrature != "all7":
             args += ["--bim-quadrature", self.quadrature]
-        return args
+        return args + ["--max-steps", str(MAX_STEPS)]
 
 
 @dataclass
@@ -285,6 +290,31 @@ def checkpoint_matches(run_dir, run):
             and args.get("bim_quadrature", "all7") == run.quadrature)
 
 
+def _failure_identity(run):
+    return {"arguments": run.arguments("OUT"), "max_steps": MAX_STEPS}
+
+
+def write_failure(out, run, error):
+    """failed.json: a run that spent its step budget, so that the next study does not run it again."""
+    record = dict(_failure_identity(run), error=error)
+    tmp = out / "failed.json.tmp"
+    tmp.write_text(json.dumps(record, indent=1) + "\n")
+    os.replace(tmp, out / "failed.json")
+
+
+def read_failure(out, run):
+    """The error of a recorded failure of exactly this run (same arguments and budget), else None."""
+    try:
+        record = json.loads((out / "failed.json").read_text())
+    except (OSError, ValueError):
+        return None
+    if not isinstance(record, dict) or not isinstance(record.get("error"), str):
+        return None
+    if {k: record.get(k) for k in ("arguments", "max_steps")} != _failure_identity(run):
+        return None
+    return record["error"]
+
+
 def execute(run, work, bendlab, counter, total):
     """Runs (or reuses) one `bendlab shear` run and returns its Result."""
     out = work / run.name
@@ -295,6 +325,12 @@ def execute(run, work, bendlab, counter, total):
             f"mean gamma dt {summary['mean_gamma_dt']:.3g}, {summary['wall_seconds']:.0f} s")
         return Result(run, summary, cached=True)
 
+    failure = read_failure(out, run)
+    if summary is None and failure is not None:
+        n = counter.next()
+        say(f"[{n:2d}/{total}] cached   {run.label()}: FAILED ({failure}; delete {out} to run it again)")
+        return Result(run, None, error=failure, cached=True)
+
     resume = summary is None and out.is_dir() and checkpoint_matches(out, run)
     if not resume and out.exists():
         shutil.rmtree(out)
@@ -302,7 +338,7 @@ def execute(run, work, bendlab, counter, total):
     say(f"[  /{total}] {'resume ' if resume else 'start  '}  {run.label()}")
     start = time.monotonic()
     rc, err = _launch(run, out, bendlab, resume)
-    if rc != 0 and resume:
+    if rc != 0 and resume and "--max-steps" not in err:
         say(f"[  /{total}] resume failed, starting over: {run.label()}")
         shutil.rmtree(out)
         out.mkdir(parents=True)
@@ -312,6 +348,8 @@ def execute(run, work, bendlab, counter, total):
     n = counter.next()
     if rc != 0 or summary is None:
         say(f"[{n:2d}/{total}] FAILED   {run.label()} (exit {rc}, {elapsed:.0f} s): {err}")
+        if "--max-steps" in err:
+            write_failure(out, run, err)
         return Result(run, None, error=err or f"exit status {rc}")
     say(f"[{n:2d}/{total}] done     {run.label()}: D_steady {summary['D_steady']:.4f}, "
         f"mean gamma dt {summary['mean_gamma_dt']:.3g}, {summary['steps']} steps, "

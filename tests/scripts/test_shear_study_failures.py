@@ -1,0 +1,40 @@
+"""The shear study's record of a run that spent its step budget (scripts/shear_study.py,
+failed.json): read back for exactly the run that wrote it, and for no other run, budget or
+damaged record, so that a changed run is run again and an unchanged one is not."""
+import json
+import sys
+from pathlib import Path
+
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "scripts"))
+import shear_study  # noqa: E402
+from shear_study import Run, read_failure, write_failure  # noqa: E402
+
+
+def run(method="M", G=0.2):
+    return Run(method, 320, G, 0.15, 10.0)
+
+
+def test_a_recorded_failure_is_read_back_for_the_same_run(tmp_path):
+    write_failure(tmp_path, run(), "bendlab: error: more than 200000 accepted steps (the budget of --max-steps)")
+    assert "--max-steps" in read_failure(tmp_path, run())
+    assert not (tmp_path / "failed.json.tmp").exists()
+
+
+def test_another_run_or_budget_does_not_see_it(tmp_path, monkeypatch):
+    write_failure(tmp_path, run(), "budget spent")
+    assert read_failure(tmp_path, run(G=0.05)) is None
+    assert read_failure(tmp_path, run(method="C")) is None
+    monkeypatch.setattr(shear_study, "MAX_STEPS", shear_study.MAX_STEPS * 2)
+    assert read_failure(tmp_path, run()) is None
+
+
+@pytest.mark.parametrize("text", ["", "{", "[]", json.dumps({"error": 3})])
+def test_a_damaged_record_is_no_failure(tmp_path, text):
+    (tmp_path / "failed.json").write_text(text)
+    assert read_failure(tmp_path, run()) is None
+
+
+def test_no_record_is_no_failure(tmp_path):
+    assert read_failure(tmp_path, run()) is None
