@@ -12,6 +12,11 @@
 //                          S's cost relative to Method C (docs/design.md).
 //   BM_Compute/E_rings<R>  Method E with neighbourhoods of R = 2 and 3 rings, 5120 triangles (every
 //                          O(N) method with a "rings" option)
+//   BM_MongeJetFit/<path>  Method M's fits alone (steps 3-5, METHOD_M.md) at every node of the RBC at
+//                          20480 triangles, one thread, on the 3-ring supports and covariance frames
+//                          the method uses: path lanes (monge_jet_fit_nodes, 8 nodes side by side in
+//                          SIMD lanes, the method's) or reference (monge_jet_fit_point, one node at a
+//                          time, Eigen's fixed-size Cholesky), at degrees 5 and 6.
 // Counters: vertices_per_s (vertices / wall-clock second) and vertices_per_s_per_thread (the same
 // divided by the OpenMP threads). Times are wall-clock (UseRealTime), since the work runs on
 // OpenMP threads.
@@ -28,6 +33,9 @@
 #include <string>
 
 #include "bendlab/bending/method_registry.hpp"
+#include "bendlab/bending/monge_jet.hpp"
+#include "bendlab/geometry/mesh_geometry.hpp"
+#include "bendlab/mesh/neighbourhood.hpp"
 #include "bendlab/mesh/generators.hpp"
 #include "bendlab/surfaces/analytic_surface.hpp"
 
@@ -94,6 +102,35 @@ void BM_Forces(benchmark::State& state, const std::string& method) {
   set_counters(state, mesh, threads);
 }
 
+// Method M's fits alone, by the batched path (lanes = true) or the per-node reference.
+void BM_MongeJetFit(benchmark::State& state, bool lanes) {
+  const int degree = static_cast<int>(state.range(0));
+  const TriMesh& mesh = rbc_mesh(20480);
+  const Points& x = mesh.positions();
+  const MeshGeometry geometry = MeshGeometry::compute(mesh.topology(), x);
+  const int n = mesh.num_vertices();
+  std::vector<std::vector<Vec3>> supports(n);
+  std::vector<MongeJetNode> nodes(n);
+  VertexRings rings(mesh.topology());
+  for (int i = 0; i < n; ++i) {
+    rings.start(i);
+    rings.grow_to(3);
+    for (const int v : rings.vertices()) supports[i].push_back(x.row(v).transpose());
+    const Vec3 x0 = x.row(i).transpose();
+    nodes[i] = MongeJetNode{x0, covariance_normal(x0, supports[i], geometry.normal_mwa.row(i).transpose()), supports[i]};
+  }
+  for (auto _ : state) {
+    if (lanes) {
+      benchmark::DoNotOptimize(monge_jet_fit_nodes(nodes, degree));
+    } else {
+      double sum = 0;
+      for (const MongeJetNode& node : nodes) sum += monge_jet_fit_point(node.x0, node.n0, node.support, degree).H;
+      benchmark::DoNotOptimize(sum);
+    }
+  }
+  state.counters["nodes_per_s"] = benchmark::Counter(n, benchmark::Counter::kIsIterationInvariantRate);
+}
+
 // Every registered method (bending/method_registry.hpp); its cost class decides the iterations.
 void register_all() {
   for (const MethodInfo& info : bending_methods()) {
@@ -113,6 +150,11 @@ void register_all() {
     auto* b = benchmark::RegisterBenchmark(("BM_Forces/" + method).c_str(), BM_Forces, method);
     b->ArgsProduct({{5120, 20480, 81920}, {1, 2}})->ArgNames({"triangles", "threads"})->UseRealTime()
         ->Unit(benchmark::kMillisecond);
+  }
+  for (const bool lanes : {true, false}) {
+    auto* b = benchmark::RegisterBenchmark(lanes ? "BM_MongeJetFit/lanes" : "BM_MongeJetFit/reference",
+                                           BM_MongeJetFit, lanes);
+    b->ArgsProduct({{5, 6}})->ArgNames({"degree"})->Unit(benchmark::kMillisecond);
   }
   // Wider neighbourhoods of the linear-cost methods with a "rings" option (E).
   for (const MethodInfo& info : bending_methods()) {

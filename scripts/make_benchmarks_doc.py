@@ -19,6 +19,7 @@ BUSY_LOAD = 2.5
 BIM_TARGET_S = 0.1            # s per single-layer evaluation, 5120 triangles, 2 threads
 CB_TARGET_VPS = 3.0e6         # vertices per second per core, Methods B and C, 81920 triangles
 E_TARGET_VPS = 0.5e6          # vertices per second per core, Method E, 81920 triangles
+M_OVER_C_TARGET = 10.0  # Method M's forces at most this many times Method C's (issue: Method M, speed)
 # Topology + geometry at 81920 triangles: the time is reported; set a limit in seconds here to
 # have it judged.
 GEOMETRY_TARGET_S = None
@@ -219,6 +220,19 @@ def main():
     per_core_target("Method B (`forces`, what a flow solver calls)", "BM_Forces", "B", CB_TARGET_VPS)
     per_core_target("Method B (`compute`, every quantity)", "BM_Compute", "B", CB_TARGET_VPS)
     per_core_target("Method E (`compute`, 1 ring)", "BM_Compute", "E", E_TARGET_VPS)
+    # Method M's cost relative to Method C's, node forces, one thread, both timed in the same run.
+    for tri in (20480,):
+        rm = find(bend, "BM_Forces", "M", triangles=tri, threads=1)
+        rc = find(bend, "BM_Forces", "C", triangles=tri, threads=1)
+        label = f"Method M (`forces`), {tri} triangles, 1 thread, at most {M_OVER_C_TARGET:g} times Method C's time"
+        if rm is None or rc is None or rm["error"] or rc["error"]:
+            w(f"| {label} | not measured | - | **not met** | - |")
+        else:
+            ratio = seconds(rm["b"]) / seconds(rc["b"])
+            cpu_ratio = cpu_seconds(rm["b"]) / cpu_seconds(rc["b"])
+            w(f"| {label} | {ms(seconds(rm['b']))} ms against {ms(seconds(rc['b']))} ms: {ratio:.1f} times | "
+              f"{M_OVER_C_TARGET / ratio:.2f} | {verdict(ratio <= M_OVER_C_TARGET)} | {cpu_ratio:.1f} times "
+              f"({M_OVER_C_TARGET / cpu_ratio:.2f}) |")
     # The solver's default quadrature (all7); reports from before the choice have no variant.
     r = find(bim, "BM_SingleLayer", "all7", triangles=5120, threads=2) or find(bim, "BM_SingleLayer", triangles=5120, threads=2)
     s = counter(r, "s_per_eval")

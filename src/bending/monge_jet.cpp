@@ -5,7 +5,9 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <mutex>
 
+#include "bendlab/bending/monge_jet_solve.hpp"
 #include "bendlab/bending/variational_assembly.hpp"
 #include "bendlab/geometry/mesh_geometry.hpp"
 #include "bendlab/mesh/neighbourhood.hpp"
@@ -19,7 +21,7 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 /// normal matrix M: below it the support is taken not to determine the jet. The scaled design
 /// matrices of the paper's meshes have condition numbers 5e2-4e3 (the spec), so M's are below
 /// about 2e7; 1e-12 refuses only configurations some 1e5 times worse than that.
-constexpr double kMinPivotRatio = 1e-12;
+constexpr double kMinPivotRatio = kJetMinPivotRatio;  // 1e-12, shared with the batched solve
 
 constexpr int unknowns_of(int degree) { return (degree + 1) * (degree + 2) / 2 - 1; }
 
@@ -36,7 +38,52 @@ MongeJetFit invalid_fit(int points) {
   return f;
 }
 
-/// The fit of METHOD_M.md steps 3-5 for a jet of degree D.
+/// Steps 1 and 3's chart: the frame (t1, t2, n0) of fit, the support's chart coordinates (u, v, w)
+/// and the scale s = RMS |(u, v)|. false when s is 0 (every point on the normal line).
+bool make_chart(const Vec3& x0, const Vec3& n0, std::span<const Vec3> support, MongeJetFit& fit,
+                std::vector<Eigen::Vector3d>& uvw) {
+  const int m = static_cast<int>(support.size());
+  fit.points = m;
+  fit.n0 = n0.normalized();
+  fit.t1 = fit.n0.unitOrthogonal();
+  fit.t2 = fit.n0.cross(fit.t1);
+  uvw.resize(m);
+  double sum_r2 = 0;
+  for (int j = 0; j < m; ++j) {
+    const Vec3 d = support[j] - x0;
+    uvw[j] = Eigen::Vector3d(d.dot(fit.t1), d.dot(fit.t2), d.dot(fit.n0));
+    sum_r2 += uvw[j][0] * uvw[j][0] + uvw[j][1] * uvw[j][1];
+  }
+  fit.scale = std::sqrt(sum_r2 / m);
+  return fit.scale > 0;
+}
+
+/// Steps 4-5: the height derivatives at the node from the coefficients c_k = c[k * stride] of the
+/// scaled jet, then n, H, K and Lap_S H of the graph; marks the fit valid.
+void finish_fit(MongeJetFit& fit, int degree, const double* c, int stride) {
+  const double inv_s = 1.0 / fit.scale;
+  // d^a_u d^b_v h(0) = a! b! c_ab / s^(a+b), orders 1 to 4 (zero above the jet's degree).
+  const std::array<double, 5> inv_s_pow{1.0, inv_s, inv_s * inv_s, inv_s * inv_s * inv_s,
+                                        (inv_s * inv_s) * (inv_s * inv_s)};
+  auto deriv = [&](int a_, int b_) {
+    if (a_ + b_ > degree) return 0.0;
+    return factorial(a_) * factorial(b_) * c[monomial_index(a_, b_) * stride] * inv_s_pow[a_ + b_];
+  };
+  HeightDerivatives& h = fit.derivatives;
+  h.u = deriv(1, 0), h.v = deriv(0, 1);
+  h.uu = deriv(2, 0), h.uv = deriv(1, 1), h.vv = deriv(0, 2);
+  h.uuu = deriv(3, 0), h.uuv = deriv(2, 1), h.uvv = deriv(1, 2), h.vvv = deriv(0, 3);
+  h.uuuu = deriv(4, 0), h.uuuv = deriv(3, 1), h.uuvv = deriv(2, 2), h.uvvv = deriv(1, 3), h.vvvv = deriv(0, 4);
+
+  const GraphCurvatures g = graph_curvatures(h);
+  fit.normal = g.normal_local[0] * fit.t1 + g.normal_local[1] * fit.t2 + g.normal_local[2] * fit.n0;
+  fit.H = g.H;
+  fit.K = g.K;
+  fit.lapH = g.lapH;
+  fit.valid = true;
+}
+
+/// The fit of METHOD_M.md steps 3-5 for a jet of degree D, one node at a time (the reference).
 template <int D>
 MongeJetFit fit_jet(const Vec3& x0, const Vec3& n0_in, std::span<const Vec3> support, bool gaussian_weights,
                    Accumulation accumulation) {
@@ -47,22 +94,8 @@ MongeJetFit fit_jet(const Vec3& x0, const Vec3& n0_in, std::span<const Vec3> sup
   if (m < P) return invalid_fit(m);
 
   MongeJetFit fit;
-  fit.points = m;
-  fit.n0 = n0_in.normalized();
-  fit.t1 = fit.n0.unitOrthogonal();
-  fit.t2 = fit.n0.cross(fit.t1);
-
-  // Chart coordinates and the length scale s = RMS |(u, v)|.
   thread_local std::vector<Eigen::Vector3d> uvw;
-  uvw.resize(m);
-  double sum_r2 = 0;
-  for (int j = 0; j < m; ++j) {
-    const Vec3 d = support[j] - x0;
-    uvw[j] = Eigen::Vector3d(d.dot(fit.t1), d.dot(fit.t2), d.dot(fit.n0));
-    sum_r2 += uvw[j][0] * uvw[j][0] + uvw[j][1] * uvw[j][1];
-  }
-  fit.scale = std::sqrt(sum_r2 / m);
-  if (!(fit.scale > 0)) return invalid_fit(m);
+  if (!make_chart(x0, n0_in, support, fit, uvw)) return invalid_fit(m);
   const double inv_s = 1.0 / fit.scale;
 
   // Normal equations of the scaled least-squares problem. Entry ((a,b), (c,d)) of Phi^T W Phi is the
@@ -112,25 +145,69 @@ MongeJetFit fit_jet(const Vec3& x0, const Vec3& n0_in, std::span<const Vec3> sup
   const double max_diag = a.diagonal().maxCoeff();
   if (!(llt.matrixLLT().diagonal().cwiseAbs2().minCoeff() > kMinPivotRatio * max_diag)) return invalid_fit(m);
   const Vec c = llt.solve(rhs);
-
-  // d^a_u d^b_v h(0) = a! b! c_ab / s^(a+b), orders 1 to 4 (zero above the jet's degree).
-  auto deriv = [&](int a_, int b_) {
-    if (a_ + b_ > D) return 0.0;
-    return factorial(a_) * factorial(b_) * c[monomial_index(a_, b_)] * std::pow(inv_s, a_ + b_);
-  };
-  HeightDerivatives& h = fit.derivatives;
-  h.u = deriv(1, 0), h.v = deriv(0, 1);
-  h.uu = deriv(2, 0), h.uv = deriv(1, 1), h.vv = deriv(0, 2);
-  h.uuu = deriv(3, 0), h.uuv = deriv(2, 1), h.uvv = deriv(1, 2), h.vvv = deriv(0, 3);
-  h.uuuu = deriv(4, 0), h.uuuv = deriv(3, 1), h.uuvv = deriv(2, 2), h.uvvv = deriv(1, 3), h.vvvv = deriv(0, 4);
-
-  const GraphCurvatures g = graph_curvatures(h);
-  fit.normal = g.normal_local[0] * fit.t1 + g.normal_local[1] * fit.t2 + g.normal_local[2] * fit.n0;
-  fit.H = g.H;
-  fit.K = g.K;
-  fit.lapH = g.lapH;
-  fit.valid = true;
+  finish_fit(fit, D, c.data(), 1);
   return fit;
+}
+
+/// Steps 3-5 at up to kJetLanes nodes side by side (monge_jet_solve.hpp): the charts and samples
+/// one node at a time, the normal equations of all of them in SIMD lanes; out[l] is node l's fit.
+void fit_lanes(std::span<const MongeJetNode> nodes, int degree, bool gaussian_weights, MongeJetFit* out) {
+  thread_local JetLaneSamples samples;
+  const int unknowns = unknowns_of(degree);
+  int count = 0;
+  for (const MongeJetNode& node : nodes) count = std::max(count, static_cast<int>(node.support.size()));
+  samples.reset(count);
+  std::array<bool, kJetLanes> active{};
+  for (std::size_t l = 0; l < nodes.size(); ++l) {
+    const MongeJetNode& node = nodes[l];
+    const int m = static_cast<int>(node.support.size());
+    MongeJetFit& fit = out[l];
+    fit = MongeJetFit{};
+    if (m < unknowns) {
+      fit = invalid_fit(m);
+      continue;
+    }
+    // make_chart's arithmetic, written straight into the lane.
+    fit.points = m;
+    fit.n0 = node.n0.normalized();
+    fit.t1 = fit.n0.unitOrthogonal();
+    fit.t2 = fit.n0.cross(fit.t1);
+    double* xi = samples.xi.data() + l;
+    double* eta = samples.eta.data() + l;
+    double* height = samples.height.data() + l;
+    double sum_r2 = 0;
+    for (int j = 0; j < m; ++j) {
+      const Vec3 d = node.support[j] - node.x0;
+      const double u = d.dot(fit.t1), v = d.dot(fit.t2);
+      xi[j * kJetLanes] = u;
+      eta[j * kJetLanes] = v;
+      height[j * kJetLanes] = d.dot(fit.n0);
+      sum_r2 += u * u + v * v;
+    }
+    fit.scale = std::sqrt(sum_r2 / m);
+    if (!(fit.scale > 0)) {
+      fit = invalid_fit(m);
+      for (int j = 0; j < m; ++j) xi[j * kJetLanes] = eta[j * kJetLanes] = height[j * kJetLanes] = 0.0;
+      continue;
+    }
+    const double inv_s = 1.0 / fit.scale;
+    for (int j = 0; j < m; ++j) xi[j * kJetLanes] *= inv_s, eta[j * kJetLanes] *= inv_s;
+    double* weight = samples.weight.data() + l;
+    if (gaussian_weights)
+      for (int j = 0; j < m; ++j)
+        weight[j * kJetLanes] = std::exp(-0.5 * (xi[j * kJetLanes] * xi[j * kJetLanes] + eta[j * kJetLanes] * eta[j * kJetLanes]));
+    else
+      for (int j = 0; j < m; ++j) weight[j * kJetLanes] = 1.0;
+    active[l] = true;
+  }
+  std::array<double, unknowns_of(6) * kJetLanes> coefficients;
+  std::array<bool, kJetLanes> determined{};
+  solve_jet_lanes(degree, samples, coefficients.data(), determined.data());
+  for (std::size_t l = 0; l < nodes.size(); ++l) {
+    if (!active[l]) continue;
+    if (determined[l]) finish_fit(out[l], degree, coefficients.data() + l, kJetLanes);
+    else out[l] = invalid_fit(out[l].points);
+  }
 }
 
 /// Positions of a VertexRings list, in a buffer reused from node to node.
@@ -158,8 +235,11 @@ Vec3 covariance_normal(const Vec3& x0, std::span<const Vec3> points, const Vec3&
     const Vec3 d = p - x0;
     c.noalias() += d * d.transpose();
   }
-  // Eigenvalues in increasing order: column 0 belongs to the smallest.
-  const Eigen::SelfAdjointEigenSolver<Mat3> eig(c);
+  // Eigenvalues in increasing order: column 0 belongs to the smallest. The closed-form 3x3 solver
+  // (a fifth of the iterative one's time) computes the most distinct eigenvalue's vector first,
+  // which here is the normal's: the two tangential eigenvalues are close, the normal's far below.
+  Eigen::SelfAdjointEigenSolver<Mat3> eig;
+  eig.computeDirect(c);
   Vec3 n = eig.eigenvectors().col(0);
   if (n.dot(orientation) < 0) n = -n;
   return n;
@@ -175,36 +255,106 @@ MongeJetFit monge_jet_fit_point(const Vec3& x0, const Vec3& n0, std::span<const 
   }
 }
 
-std::vector<MongeJetFit> monge_jet_fit(const Topology& t, const Points& x, const Points& mwa_normal,
-                                       const MongeJetSettings& settings) {
+std::vector<MongeJetFit> monge_jet_fit_nodes(std::span<const MongeJetNode> nodes, int degree,
+                                             bool gaussian_weights) {
+  if (degree < 4 || degree > 6) throw Error(fmt::format("method M: degree must be 4, 5 or 6, got {}", degree));
+  std::vector<MongeJetFit> fits(nodes.size());
+  for (std::size_t first = 0; first < nodes.size(); first += kJetLanes)
+    fit_lanes(nodes.subspan(first, std::min<std::size_t>(kJetLanes, nodes.size() - first)), degree,
+              gaussian_weights, fits.data() + first);
+  return fits;
+}
+
+MongeJetSupports MongeJetSupports::build(const Topology& t, const MongeJetSettings& settings) {
   check_settings(settings);
   const int n = t.num_vertices();
   const int min_points = monge_jet_min_points(settings.degree);
+  MongeJetSupports s;
+  s.faces = t.faces();
+  s.rings = settings.rings;
+  s.min_points = min_points;
+  s.two_ring.resize(n);
+  s.rings_used.resize(n);
+  std::vector<std::vector<int>> lists(n);
+#pragma omp parallel
+  {
+    VertexRings nb(t);
+#pragma omp for schedule(static)
+    for (int i = 0; i < n; ++i) {
+      nb.start(i);
+      nb.grow_to(2);
+      s.two_ring[i] = static_cast<int>(nb.vertices().size());
+      nb.grow_to(settings.rings);
+      bool more = true;
+      while (more && static_cast<int>(nb.vertices().size()) < min_points) more = nb.add_ring();
+      lists[i] = nb.vertices();
+      s.rings_used[i] = nb.rings();
+    }
+  }
+  s.offsets.assign(n + 1, 0);
+  for (int i = 0; i < n; ++i) s.offsets[i + 1] = s.offsets[i] + static_cast<int>(lists[i].size());
+  s.vertices.reserve(s.offsets[n]);
+  for (const auto& list : lists) s.vertices.insert(s.vertices.end(), list.begin(), list.end());
+  return s;
+}
+
+bool MongeJetSupports::matches(const Topology& t, const MongeJetSettings& settings) const {
+  return t.num_vertices() + 1 == static_cast<int>(offsets.size()) && rings == settings.rings &&
+         min_points == monge_jet_min_points(settings.degree) && t.faces() == faces;
+}
+
+std::vector<MongeJetFit> monge_jet_fit(const Topology& t, const Points& x, const Points& mwa_normal,
+                                       const MongeJetSettings& settings) {
+  return monge_jet_fit(t, x, mwa_normal, settings, MongeJetSupports::build(t, settings));
+}
+
+std::vector<MongeJetFit> monge_jet_fit(const Topology& t, const Points& x, const Points& mwa_normal,
+                                       const MongeJetSettings& settings, const MongeJetSupports& lists) {
+  check_settings(settings);
+  if (!lists.matches(t, settings))
+    throw Error("method M: the support lists were built for another mesh connectivity or other options");
+  const int n = t.num_vertices();
   std::vector<MongeJetFit> fits(n);
+  // kJetLanes nodes at a time: their supports one by one, their fits side by side (fit_lanes).
+  const int batches = (n + kJetLanes - 1) / kJetLanes;
 #pragma omp parallel
   {
     VertexRings nb(t);
     std::vector<Vec3> buffer;
+    std::array<std::vector<Vec3>, kJetLanes> supports;
+    std::array<MongeJetNode, kJetLanes> nodes;
 #pragma omp for schedule(static)
-    for (int i = 0; i < n; ++i) {
-      const Vec3 x0 = x.row(i).transpose(), mwa = mwa_normal.row(i).transpose();
-      nb.start(i);
-      Vec3 n0 = mwa;
-      if (settings.frame == MongeFrame::Covariance) {
-        nb.grow_to(2);
-        n0 = covariance_normal(x0, gather(x, nb.vertices(), buffer), mwa);
+    for (int b = 0; b < batches; ++b) {
+      const int first = b * kJetLanes, count = std::min(kJetLanes, n - first);
+      for (int l = 0; l < count; ++l) {
+        // The support of step 2 (rings listed ring after ring, so the frame's 2-ring is a prefix).
+        const int i = first + l;
+        std::vector<Vec3>& support = supports[l];
+        support.resize(lists.offsets[i + 1] - lists.offsets[i]);
+        for (std::size_t k = 0; k < support.size(); ++k) support[k] = x.row(lists.vertices[lists.offsets[i] + k]).transpose();
+        const Vec3 x0 = x.row(i).transpose(), mwa = mwa_normal.row(i).transpose();
+        const Vec3 n0 = settings.frame == MongeFrame::AngleWeighted
+                            ? mwa
+                            : covariance_normal(x0, std::span<const Vec3>(support).first(lists.two_ring[i]), mwa);
+        nodes[l] = MongeJetNode{x0, n0, support};
       }
-      nb.grow_to(settings.rings);
-      bool more = true;
-      while (more && static_cast<int>(nb.vertices().size()) < min_points) more = nb.add_ring();
-      MongeJetFit fit =
-          monge_jet_fit_point(x0, n0, gather(x, nb.vertices(), buffer), settings.degree, settings.gaussian_weights);
-      // A singular configuration: widen the support.
-      while (!fit.valid && nb.add_ring())
-        fit = monge_jet_fit_point(x0, n0, gather(x, nb.vertices(), buffer), settings.degree,
-                                  settings.gaussian_weights);
-      fit.rings = nb.rings();
-      fits[i] = fit;
+      fit_lanes(std::span<const MongeJetNode>(nodes.data(), count), settings.degree, settings.gaussian_weights,
+                fits.data() + first);
+      for (int l = 0; l < count; ++l) {
+        const int i = first + l;
+        MongeJetFit& fit = fits[i];
+        int rings = lists.rings_used[i];
+        if (!fit.valid) {
+          // A singular configuration: widen the support ring by ring, one node at a time.
+          nb.start(i);
+          nb.grow_to(rings);
+          while (!fit.valid && nb.add_ring())
+            fit = monge_jet_fit_point(nodes[l].x0, nodes[l].n0, gather(x, nb.vertices(), buffer), settings.degree,
+                                      settings.gaussian_weights);
+          rings = nb.rings();
+        }
+        fit.rings = rings;
+      }
     }
   }
   const int unknowns = monge_jet_unknowns(settings.degree);
@@ -223,6 +373,20 @@ std::vector<MongeJetFit> monge_jet_fit(const Topology& t, const Points& x, const
 }
 
 MongeJetMethod::MongeJetMethod(MongeJetSettings settings) : settings_(settings) { check_settings(settings_); }
+
+std::shared_ptr<const MongeJetSupports> MongeJetMethod::supports_for(const Topology& topology) const {
+  {
+    std::lock_guard<std::mutex> lock(cache_mutex_);
+    auto it = cache_.find(&topology);
+    if (it != cache_.end() && it->second->matches(topology, settings_)) return it->second;
+  }
+  // Built outside the lock; a concurrent builder for the same topology does the same work once more.
+  auto entry = std::make_shared<const MongeJetSupports>(MongeJetSupports::build(topology, settings_));
+  std::lock_guard<std::mutex> lock(cache_mutex_);
+  if (cache_.size() >= kMaxCachedTopologies && !cache_.count(&topology)) cache_.erase(cache_.begin());
+  cache_[&topology] = entry;
+  return entry;
+}
 
 std::unique_ptr<BendingMethod> MongeJetMethod::create(const MethodOptions& options) {
   MongeJetSettings s;
@@ -252,7 +416,7 @@ MethodInfo MongeJetMethod::info() {
 
 BendingResult MongeJetMethod::compute(const Topology& topology, const Points& x, double kappa_b) const {
   const MeshGeometry geometry = MeshGeometry::compute(topology, x);
-  const std::vector<MongeJetFit> fits = monge_jet_fit(topology, x, geometry.normal_mwa, settings_);
+  const std::vector<MongeJetFit> fits = monge_jet_fit(topology, x, geometry.normal_mwa, settings_, *supports_for(topology));
   const auto n = static_cast<Eigen::Index>(fits.size());
   Points normal(n, 3);
   Scalars H(n), K(n), lapH(n);

@@ -12,6 +12,7 @@
 #include "bendlab/bending/graph_curvature.hpp"
 #include "bendlab/bending/method_registry.hpp"
 #include "bendlab/bending/monge_jet.hpp"
+#include "bendlab/geometry/mesh_geometry.hpp"
 #include "bendlab/mesh/generators.hpp"
 #include "bendlab/surfaces/analytic_surface.hpp"
 
@@ -259,6 +260,61 @@ TEST(MongeJetFit, TooFewOrDegeneratePointsAreInvalid) {
   EXPECT_FALSE(monge_jet_fit_point(g.point(0, 0), g.q.col(2), lines, 5).valid);
 }
 
+TEST(MongeJetFit, LanesEqualTheOneNodeReference) {
+  // monge_jet_fit_nodes (8 nodes side by side in SIMD lanes, the method's path) against
+  // monge_jet_fit_point one node at a time: 19 nodes (two full batches and a partial one) with
+  // supports of different sizes and noise, one with too few points and one degenerate (points on
+  // two lines) among them, every degree, with and without weights.
+  std::mt19937 gen(5);
+  std::normal_distribution<double> noise(0, 1e-3);
+  const PolynomialGraph g(6);
+  std::vector<std::vector<Vec3>> supports;
+  std::vector<MongeJetNode> nodes;
+  for (int k = 0; k < 19; ++k) {
+    const double u0 = 0.01 * k - 0.09, v0 = 0.05 - 0.007 * k;
+    std::vector<Vec3> support;
+    if (k == 4) {
+      support = graph_support(g, u0, v0, 12, 0.15, 3);  // fewer points than unknowns
+    } else if (k == 11) {
+      for (int j = 1; j <= 18; ++j) support.push_back(g.point(u0 + 0.01 * j, v0)), support.push_back(g.point(u0, v0 - 0.01 * j));
+    } else {
+      support = graph_support(g, u0, v0, 30 + k % 9, 0.15, 4);
+      for (Vec3& q : support) q += Vec3(noise(gen), noise(gen), noise(gen));
+    }
+    supports.push_back(std::move(support));
+  }
+  for (int k = 0; k < 19; ++k) {
+    const double u0 = 0.01 * k - 0.09, v0 = 0.05 - 0.007 * k;
+    nodes.push_back(MongeJetNode{g.point(u0, v0), (g.q * Vec3(0.03 * k - 0.2, 0.02, 1)).normalized(), supports[k]});
+  }
+  for (const int degree : {4, 5, 6})
+    for (const bool weights : {false, true}) {
+      const std::vector<MongeJetFit> lanes = monge_jet_fit_nodes(nodes, degree, weights);
+      ASSERT_EQ(lanes.size(), nodes.size());
+      for (int k = 0; k < 19; ++k) {
+        const MongeJetFit ref = monge_jet_fit_point(nodes[k].x0, nodes[k].n0, nodes[k].support, degree, weights);
+        const MongeJetFit& fit = lanes[k];
+        ASSERT_EQ(fit.valid, ref.valid) << "node " << k << ", degree " << degree;
+        EXPECT_EQ(fit.points, ref.points);
+        if (k == 4 || k == 11) EXPECT_FALSE(fit.valid) << k;
+        if (!ref.valid) {
+          EXPECT_TRUE(std::isnan(fit.H) && std::isnan(fit.lapH) && std::isnan(fit.normal.x())) << k;
+          continue;
+        }
+        // Two backward-stable solves of the same normal equations differ by round-off times the
+        // normal matrix's condition number: the spec's design matrices have 5e2-4e3, so up to
+        // 2e7 for M = Phi^T Phi, i.e. about 4e-9 relative in the coefficients.
+        EXPECT_NEAR(fit.scale, ref.scale, 1e-15 * ref.scale);
+        EXPECT_NEAR(fit.H, ref.H, 1e-8 * std::abs(ref.H)) << k << " " << degree;
+        EXPECT_NEAR(fit.K, ref.K, 1e-8 * std::abs(ref.K)) << k << " " << degree;
+        EXPECT_NEAR(fit.lapH, ref.lapH, 1e-7 * (1 + std::abs(ref.lapH))) << k << " " << degree;
+        EXPECT_NEAR((fit.normal - ref.normal).norm(), 0.0, 1e-9) << k << " " << degree;
+      }
+    }
+  EXPECT_TRUE(monge_jet_fit_nodes({}, 6).empty());
+  EXPECT_THROW(monge_jet_fit_nodes(nodes, 7), Error);
+}
+
 TEST(MongeJet, RegistryEntryAndOptions) {
   const MethodInfo& info = bending_method_info("M");
   EXPECT_FALSE(info.capabilities.has_energy);
@@ -324,6 +380,37 @@ TEST(MongeJet, RigidMotionsAndScalingActAsTheyMust) {
     EXPECT_NEAR((q * row(r0.force_density, i) - row(r1.force_density, i)).norm(), 0.0, 1e-8 * fmax);
     EXPECT_NEAR((row(r0.force_density, i) - l * l * l * row(r2.force_density, i)).norm(), 0.0, 1e-8 * fmax);
   }
+}
+
+TEST(MongeJet, KeptSupportsFollowTheConnectivity) {
+  // The method keeps each connectivity's supports: one method object on two meshes in turn (and
+  // on a mesh with the same vertex count but other faces) gives what fresh objects give, and
+  // supports built for one connectivity are refused for another.
+  const TriMesh a = sphere_mesh(MeshFamily::MT1, 2), b = sphere_mesh(MeshFamily::MT2, 2);
+  std::vector<Eigen::Vector3i> flipped;  // a's faces in another order and rotation: other faces, same surface
+  for (Eigen::Index f = a.topology().faces().rows() - 1; f >= 0; --f) {
+    const auto& row_f = a.topology().faces().row(f);
+    flipped.emplace_back(row_f[1], row_f[2], row_f[0]);
+  }
+  Faces faces(static_cast<Eigen::Index>(flipped.size()), 3);
+  for (std::size_t f = 0; f < flipped.size(); ++f) faces.row(static_cast<Eigen::Index>(f)) = flipped[f].transpose();
+  const TriMesh c(a.positions(), faces);
+  const auto kept = make_bending_method("M");
+  for (const TriMesh* m : {&a, &b, &a, &c, &b}) {
+    const BendingResult r = kept->compute(m->topology(), m->positions(), 1.0);
+    const BendingResult fresh = make_bending_method("M")->compute(m->topology(), m->positions(), 1.0);
+    EXPECT_EQ(r.force, fresh.force);
+    EXPECT_EQ(r.H, fresh.H);
+  }
+  const MongeJetSettings settings;
+  const MongeJetSupports supports = MongeJetSupports::build(a.topology(), settings);
+  EXPECT_TRUE(supports.matches(a.topology(), settings));
+  EXPECT_FALSE(supports.matches(c.topology(), settings));
+  MongeJetSettings two_rings = settings;
+  two_rings.rings = 2;
+  EXPECT_FALSE(supports.matches(a.topology(), two_rings));
+  const MeshGeometry g = MeshGeometry::compute(c.topology(), c.positions());
+  EXPECT_THROW(monge_jet_fit(c.topology(), c.positions(), g.normal_mwa, settings, supports), Error);
 }
 
 TEST(MongeJet, SphereMeshesConvergeToTheSphere) {

@@ -30,8 +30,10 @@
 // (irregular), 2e-4 (octahedron, 131072) against degree 5's 8e-3 to 1e-2, it is also the more
 // accurate from 5120 triangles on, and the capsule runs are stable (docs/results/shear.md).
 #include <memory>
+#include <mutex>
 #include <span>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "bendlab/bending/graph_curvature.hpp"
@@ -82,11 +84,42 @@ enum class Accumulation { Moments, OuterProducts };
 MongeJetFit monge_jet_fit_point(const Vec3& x0, const Vec3& n0, std::span<const Vec3> support, int degree,
                                 bool gaussian_weights = false, Accumulation accumulation = Accumulation::Moments);
 
+/// One node's problem for monge_jet_fit_nodes: the node, its chart normal and its support.
+struct MongeJetNode {
+  Vec3 x0 = Vec3::Zero(), n0 = Vec3::Zero();
+  std::span<const Vec3> support;
+};
+
+/// Steps 3-5 at many nodes, kJetLanes (8) at a time, their normal equations summed, factored and
+/// solved side by side in SIMD lanes (monge_jet_solve.hpp): the fits monge_jet_fit_point gives (to
+/// round-off; it is the reference this is tested against), in the order of `nodes`. The fast path
+/// of monge_jet_fit; moments accumulation.
+std::vector<MongeJetFit> monge_jet_fit_nodes(std::span<const MongeJetNode> nodes, int degree,
+                                             bool gaussian_weights = false);
+
+/// Step 2's supports before any widening for a singular fit, which depend on the connectivity
+/// only (built once per mesh and kept by the method): for every vertex the vertices within `rings`
+/// rings, widened while fewer than monge_jet_min_points, listed ring after ring (VertexRings order).
+struct MongeJetSupports {
+  std::vector<int> offsets;     ///< N + 1: vertex i's support is vertices[offsets[i] .. offsets[i + 1])
+  std::vector<int> vertices;
+  std::vector<int> two_ring;    ///< N: how many of vertex i's support form its 2-ring (the frame's)
+  std::vector<int> rings_used;  ///< N: rings of the support
+  Faces faces;                  ///< the connectivity they were built for
+  int rings = 0, min_points = 0;
+  static MongeJetSupports build(const Topology& topology, const MongeJetSettings& settings);
+  /// Built for this connectivity (faces compared entry by entry) and these settings.
+  bool matches(const Topology& topology, const MongeJetSettings& settings) const;
+};
+
 /// The fit at every node, with the support rule of step 2 (rings widened where needed). Throws
 /// bendlab::Error naming the method and the first vertex that cannot be fitted (too few vertices in
 /// the whole connected mesh, or a singular system even with every vertex), before anything else.
 std::vector<MongeJetFit> monge_jet_fit(const Topology& topology, const Points& x, const Points& mwa_normal,
                                        const MongeJetSettings& settings);
+/// The same with the supports built beforehand (refused, bendlab::Error, when they do not match).
+std::vector<MongeJetFit> monge_jet_fit(const Topology& topology, const Points& x, const Points& mwa_normal,
+                                       const MongeJetSettings& settings, const MongeJetSupports& supports);
 
 /// Method M.
 class MongeJetMethod : public BendingMethod {
@@ -101,7 +134,12 @@ class MongeJetMethod : public BendingMethod {
   const MongeJetSettings& settings() const { return settings_; }
 
  private:
+  /// The supports of a connectivity, built on first use and kept (a flow run's meshes keep theirs).
+  std::shared_ptr<const MongeJetSupports> supports_for(const Topology& topology) const;
+  static constexpr std::size_t kMaxCachedTopologies = 4;
   MongeJetSettings settings_;
+  mutable std::mutex cache_mutex_;
+  mutable std::unordered_map<const Topology*, std::shared_ptr<const MongeJetSupports>> cache_;
 };
 
 }  // namespace bendlab
