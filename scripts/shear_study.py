@@ -67,6 +67,7 @@ import json
 import math
 import os
 import platform
+import re
 import shlex
 import shutil
 import signal
@@ -288,6 +289,13 @@ def checkpoint_matches(run_dir, run):
             and close(args.get("G"), run.G) and close(args.get("kappa_b_hat"), run.kappa_b)
             and args.get("integrator", "cash-karp") == run.integrator
             and args.get("bim_quadrature", "all7") == run.quadrature)
+
+
+def failure_reason(error):
+    """A run's error as the document shows it: without the program's prefix and the checkpoint's path."""
+    text = (error or "").removeprefix("bendlab: error: ")
+    return re.sub(r"; the last checkpoint, at gamma t = ([0-9.eE+-]+), is whole in '[^']*'$",
+                  r" (last checkpoint at gamma t = \1)", text)
 
 
 def _failure_identity(run):
@@ -813,7 +821,7 @@ def section_e(results, runs, fig_dir, rel, t_end, n, meta):
              f"- gamma t from 0 to **{fmt_g(t_end)}** in every run"
              + ("" if t_end >= 10 else " (a preview: the paper runs to 10)"),
              "",
-             f"Every run is `bendlab shear --method M --mesh mt1:{n} --G G --kappa-b-hat KB --t-end T --no-plot "
+             f"Every run is `bendlab shear --method METHOD --mesh mt1:{n} --G G --kappa-b-hat KB --t-end T --no-plot "
              f"--integrator {it} --rtol {RTOL} --atol {ATOL}"
              + ("" if E_QUADRATURE == "all7" else f" --bim-quadrature {E_QUADRATURE}")
              + "`: the boundary integral method as in parts "
@@ -1281,7 +1289,7 @@ def main():
              f"- parts shown: {', '.join(shown)}" + (f"; failed runs: {len(failed)}" if failed else ""),
              f"- source commit: {commit}" if commit else None,
              "",
-             "Every run is `bendlab shear --method M --mesh mt1:N --G G --kappa-b-hat KB --t-end T --no-plot` "
+             "Every run is `bendlab shear --method METHOD --mesh mt1:N --G G --kappa-b-hat KB --t-end T --no-plot` "
              "(boundary integral method, Cash-Karp with relative tolerance 1e-7 and absolute tolerance "
              "1e-6 R). Units: G = mu gamma R / kS and kB_hat = kB / (R^2 kS) with the neo-Hookean "
              "modulus kS of eq. (18), which is three times the shear modulus Gs: the capillary number "
@@ -1299,6 +1307,13 @@ def main():
         if p not in shown:
             lines += [f"## ({p})", "", f"Not shown: part ({p}) was not run with these options "
                       f"(run `--only {p}` or without --only).", ""]
+    if failed:
+        lines += ["### Failed runs", "",
+                  "Runs that ended with an error (their last checkpoint kept in the work folder; a run that "
+                  f"spent the budget of {MAX_STEPS} accepted steps is not run again until its folder is "
+                  "deleted):", ""]
+        lines += [f"- {r.run.label()}: {failure_reason(r.error)}" for r in sorted(failed, key=lambda r: r.run.label())]
+        lines.append("")
     text = "\n".join(lines)
     # Part (e) is written by --only e alone: its section of the earlier document stays.
     kept = old_block(doc, E_BEGIN, E_END)

@@ -38,3 +38,15 @@ def test_a_damaged_record_is_no_failure(tmp_path, text):
 
 def test_no_record_is_no_failure(tmp_path):
     assert read_failure(tmp_path, run()) is None
+
+
+def test_the_document_shows_the_reason_without_the_prefix_and_path():
+    error = ("bendlab: error: the run failed after step 100000 (gamma t = 3.87163): more than 100000 accepted "
+             "steps (the budget of --max-steps) to reach gamma t = 10 (mean gamma dt 3.87e-05; the last step "
+             "4.04e-08); the last checkpoint, at gamma t = 3.5102, is whole in '/x/y/checkpoint.json'")
+    reason = shear_study.failure_reason(error)
+    assert reason.startswith("the run failed after step 100000")
+    assert reason.endswith("(last checkpoint at gamma t = 3.5102)")
+    assert "/x/y" not in reason and "bendlab: error" not in reason
+    assert shear_study.failure_reason("exit status 3") == "exit status 3"
+    assert shear_study.failure_reason(None) == ""
