@@ -1054,11 +1054,13 @@ def added_runs(added, t_end, triangles):
 
 
 def source_commit():
-    """The short hash of HEAD, marked when tracked files differ from it ('' outside git)."""
+    """The short hash of HEAD, marked when tracked files other than results (docs/results, studies)
+    differ from it: the study's own outputs do not make its source uncommitted ('' outside git)."""
     try:
         commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
                                 text=True).stdout.strip()
-        if commit and subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], cwd=ROOT,
+        if commit and subprocess.run(["git", "status", "--porcelain", "--untracked-files=no", "--", ".",
+                                      ":!docs/results", ":!studies"], cwd=ROOT,
                                      capture_output=True, text=True).stdout.strip():
             commit += " with uncommitted changes"
         return commit
