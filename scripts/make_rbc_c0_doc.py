@@ -114,7 +114,7 @@ def main(argv):
                  [f"{s['maxima']['f']:.6g} at {label(s['c0'])}" for _, s in studies]) + ").", ""]
     c0s = [0.0] + [s["c0"] for _, s in studies]
     all_studies = [baseline] + [s for _, s in studies]
-    kept, changed = [], []
+    kept, changed, moved = [], [], []
     for fam in FAMILIES:
         for measure, word in MEASURES:
             lines += [f"## {fam.upper()}, {word} error of f", "",
@@ -125,11 +125,18 @@ def main(argv):
                 symbols = [(rate(s, fam, measure, m) or {}).get("symbol") for s in all_studies]
                 same = len(set(symbols)) == 1 and symbols[0] is not None
                 (kept if same else changed).append(f"{m} ({fam.upper()}, {measure})")
+                slopes = [(rate(s, fam, measure, m) or {}).get("slope_tail") for s in all_studies]
+                if None not in slopes and max(slopes) - min(slopes) > 0.3:
+                    moved.append(f"{m} ({fam.upper()}, {measure}: slope " +
+                                 " / ".join(f"{x:+.1f}" for x in slopes) + ")")
                 lines.append(f"| {m} | " + " | ".join(cells) + f" | {'yes' if same else '**no**'} |")
             lines.append("")
     lines += ["## Which methods keep their convergence behaviour", "",
-              "Same symbol at every c0: " + (", ".join(kept) if kept else "none") + ".", "",
-              "Symbol changes with c0: " + (", ".join(changed) if changed else "none") + ".", "",
+              f"The symbol is the same at every c0 in {len(kept)} of {len(kept) + len(changed)} cells"
+              + (" (every method, family and measure)." if not changed else "; it changes in: " +
+                 ", ".join(changed) + "."), "",
+              "Slopes that move by more than 0.3 between the c0 values: " +
+              (", ".join(moved) if moved else "none") + ".", "",
               "A symbol may change where a slope lies near a threshold of table 2 (−0.5 for ●, +0.25 for ■); the "
               "slopes show how far the behaviour moved. The c0 part of the force law, "
               "2 kB [2 (H − c0)(H² + c0 H − K) − 2 H (H² − K)] = 4 kB c0 (K − c0 H), is algebraic in H and K, "
