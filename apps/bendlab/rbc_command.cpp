@@ -161,9 +161,9 @@ const CommandRegistration registration([](CLI::App& app) {
   cmd->add_option("--jitter-seed", args->jitter_seed, "irregular family: base seed; level k uses seed (base + k)")
       ->capture_default_str();
   add_membrane_term_options(cmd, args->terms, false,
-                            " (units of R; the exact f is the force law of docs/conventions.md §5 from the exact H, K, "
-                            "Lap H; ADE's A and M are the exact RBC's; without --methods, methods that refuse c0/ADE "
-                            "are left out)");
+                            " (lengths in units of R: c0 R, d / R, dA0 / R^2; the exact f is the force law of "
+                            "docs/conventions.md §5 from the exact H, K, Lap H, and ADE's A and M are the exact RBC's; "
+                            "without --methods, methods that refuse c0/ADE are left out)");
   cmd->add_option("--out", args->out, "output folder (created if missing)")->required();
   cmd->add_flag("--plots,!--no-plots", args->plots, "run scripts/plot_rbc.py on the output to draw the PNG plots "
                                                    "(default: on)");
