@@ -21,6 +21,7 @@ struct ForcesArgs {
   bool small_angle = false;
   std::vector<std::string> options;  // --option key=value
   std::vector<double> axes;
+  MembraneTermArgs terms;
 };
 
 void run_forces(const ForcesArgs& a) {
@@ -32,16 +33,21 @@ void run_forces(const ForcesArgs& a) {
   if (a.small_angle) options["small_angle"] = "true";
   add_option_assignments(options, a.options);
   const auto method = make_bending_method(a.method, options);
+  const BendingParameters params = membrane_parameters(a.kappa_b, a.terms);
+  method->check_parameters(params);
   std::unique_ptr<AnalyticSurface> surface;
   if (!a.shape.empty()) surface = surface_from_options(a.shape, a.radius, a.axes);
   const TriMesh mesh = read_mesh(a.mesh);
   if (surface) require_nodes_on_surface(*surface, mesh.positions(), a.surface_tolerance);
 
-  const BendingResult r = method->compute(mesh.topology(), mesh.positions(), a.kappa_b);
+  const BendingResult r = method->compute(mesh.topology(), mesh.positions(), params);
   require_finite_result(r, a.method);  // nothing is written from a result with NaN or infinity
   SurfaceFields exact;
   NodeErrors err;
   if (surface) {
+    if (!params.plain())
+      throw Error("--shape with --c0 or --ade-alpha: the analytic values with c0 and ADE are those of "
+                  "bendlab rbc --c0 (forces compares against eq. (10))");
     exact = surface->evaluate(mesh.positions(), a.kappa_b);
     err = node_errors(exact, surface->maxima(a.kappa_b), r, a.kappa_b);
   }
@@ -89,6 +95,7 @@ const CommandRegistration registration([](CLI::App& app) {
   cmd->add_option("--kappa-b", args->kappa_b, "bending modulus kB")->capture_default_str();
   cmd->add_option("--rings", args->rings, "fitting support of E and ED in rings of neighbours (1, 2, 3)")
       ->check(CLI::Range(1, 3));
+  add_membrane_term_options(cmd, args->terms, true, "");
   cmd->add_flag("--small-angle", args->small_angle, "method A: small-angle form theta^2/2 of 1 - cos(theta)");
   cmd->add_option("--option", args->options, "method option key=value, repeatable (the options of each method: "
                                              "bendlab methods), e.g. --option rings=2");

@@ -32,6 +32,8 @@ struct RbcArgs {
   bool plots = true;
   std::string plot_script;
   std::string python = "/usr/bin/python3";
+  MembraneTermArgs terms;
+  bool methods_given = false;
 };
 
 // Fails early, with a one-line message, when files cannot be created in dir.
@@ -53,6 +55,26 @@ void run_rbc(const RbcArgs& a) {
   o.base = a.base;
   o.jitter = a.jitter;
   o.jitter_seed = a.jitter_seed;
+  // c0 / ADE (docs/conventions.md §5); A is the exact area of the RBC (refused if given).
+  if (a.terms.ade_area) throw Error("--ade-area: rbc uses the exact area of the analytic RBC");
+  const BendingParameters params = membrane_parameters(o.kappa_b, a.terms, 1.0);
+  o.c0 = params.c0;
+  o.ade_alpha = params.ade_alpha;
+  o.ade_d = params.ade_d;
+  o.ade_da0 = params.ade_da0;
+  if (!params.plain() && !a.methods_given) {
+    // The default list: the methods that take c0 and ADE (A does not, §5).
+    std::vector<std::string> keep;
+    for (const std::string& m : o.methods) {
+      try {
+        make_bending_method(m)->check_parameters(params);
+        keep.push_back(m);
+      } catch (const Error& e) {
+        note(fmt::format("rbc: method {} left out: {}", m, e.what()));
+      }
+    }
+    o.methods = keep;
+  }
   if (a.rings) {
     if (*a.rings < 1 || *a.rings > 3) throw Error(fmt::format("--rings must be 1, 2 or 3, got {}", *a.rings));
     o.method_options["rings"] = std::to_string(*a.rings);
@@ -138,6 +160,10 @@ const CommandRegistration registration([](CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--jitter-seed", args->jitter_seed, "irregular family: base seed; level k uses seed (base + k)")
       ->capture_default_str();
+  add_membrane_term_options(cmd, args->terms, false,
+                            " (lengths in units of R: c0 R, d / R, dA0 / R^2; the exact f is the force law of "
+                            "docs/conventions.md §5 from the exact H, K, Lap H, and ADE's A and M are the exact RBC's; "
+                            "without --methods, methods that refuse c0/ADE are left out)");
   cmd->add_option("--out", args->out, "output folder (created if missing)")->required();
   cmd->add_flag("--plots,!--no-plots", args->plots, "run scripts/plot_rbc.py on the output to draw the PNG plots "
                                                    "(default: on)");
@@ -145,7 +171,9 @@ const CommandRegistration registration([](CLI::App& app) {
                   "path of plot_rbc.py (default: share/bendlab/scripts/ of an installed bendlab, or scripts/ "
                   "found in or above the executable's folder or the current folder)");
   cmd->add_option("--python", args->python, "Python interpreter with numpy and matplotlib")->capture_default_str();
-  cmd->callback([args, families, methods] {
+  auto* methods_option = cmd->get_option("--methods");
+  cmd->callback([args, families, methods, methods_option] {
+    args->methods_given = methods_option->count() > 0;
     args->families = split_list(*families);
     args->methods = split_list(*methods);
     run_rbc(*args);

@@ -35,6 +35,7 @@ struct ShearArgs {
   std::int64_t stop_after_steps = 0, max_steps = 0;
   bool resume = false, overwrite = false, plot = true;
   LatticeRunSpec lattice;  // --solver lbm
+  MembraneTermArgs terms;  // --c0, --ade-*
   // Which options the user gave (the other solver's options are refused).
   bool given_tolerance = false, given_lattice = false;
 };
@@ -76,6 +77,11 @@ void shear(const ShearArgs& a) {
   spec.G = a.G;
   spec.kappa_b_hat = a.kappa_b_hat;
   spec.kappa_b = a.kappa_b;
+  spec.c0 = a.terms.c0;
+  spec.ade_alpha = a.terms.ade_alpha;
+  spec.ade_d = a.terms.ade_d;
+  spec.ade_da0 = a.terms.ade_da0;
+  spec.ade_area = a.terms.ade_area;
   spec.t_end = a.t_end;
   spec.snapshot_every = a.snapshot_every;
   spec.rtol = a.rtol;
@@ -147,6 +153,9 @@ const CommandRegistration registration([](CLI::App& app) {
   auto* dim = cmd->add_option("--kappa-b", args->kappa_b,
                               "dimensional bending modulus kB = kappa_b_hat / G (R = mu = gamma = 1)");
   hat->excludes(dim);
+  add_membrane_term_options(cmd, args->terms, true,
+                            " (dimensionless, in units of the capsule radius R = 1: c0 R, d / R, dA0 / R^2, A / R^2; "
+                            "ADE's A defaults to the initial area; part of the run's identity on --resume)");
   cmd->add_option("--t-end", args->t_end, "end of the run in gamma t")->capture_default_str();
   auto tolerance = [args](const std::string&) { args->given_tolerance = true; };
   cmd->add_option("--integrator", args->integrator,

@@ -35,7 +35,32 @@ void require_kappa(double kappa_b) { require_positive("kappa_b", kappa_b, true);
 /// A method with the options it was made with (methods are immutable and may be shared).
 struct PyMethod {
   std::shared_ptr<const BendingMethod> method;
+  BendingParameters terms;  ///< c0 and ADE (docs/conventions.md §5); its kappa_b is replaced per call
+  BendingParameters with(double kappa_b) const {
+    BendingParameters p = terms;
+    p.kappa_b = kappa_b;
+    return p;
+  }
 };
+
+/// Takes c0, ade_alpha, ade_d, ade_da0, ade_area out of the keyword arguments.
+BendingParameters terms_from(py::dict& kwargs) {
+  BendingParameters p;
+  auto take_real = [&](const char* key, double& v) {
+    if (!kwargs.contains(key)) return;
+    v = kwargs[key].cast<double>();
+    PyDict_DelItemString(kwargs.ptr(), key);
+  };
+  take_real("c0", p.c0);
+  take_real("ade_alpha", p.ade_alpha);
+  take_real("ade_d", p.ade_d);
+  take_real("ade_da0", p.ade_da0);
+  take_real("ade_area", p.ade_area);
+  if (!p.has_ade() && (p.ade_d != 0 || p.ade_da0 != 0 || p.ade_area != 0))
+    throw Error("ade_d, ade_da0 and ade_area need ade_alpha > 0");
+  if (p.has_ade() && p.ade_area == 0) throw Error("ade_alpha needs ade_area (the membrane area A of the ADE coefficient)");
+  return p;
+}
 
 }  // namespace
 
@@ -89,10 +114,16 @@ void bind_bending(py::module_& m) {
 
   py::class_<PyMethod>(m, "Method",
                        "A bending method of the paper (A Kantor-Nelson, B Gompper-Kroll, C Meyer, D Belkin, "
-                       "E Farutin, ED, S Loop shell) with its options, e.g. Method('E', rings=2). "
-                       "bendlab.methods() lists them.")
-      .def(py::init([](const std::string& name, const py::kwargs& options) {
-             return PyMethod{std::shared_ptr<const BendingMethod>(make_bending_method(name, options_from(options)))};
+                       "E Farutin, ED, S Loop shell, J Juelicher, M Monge jet) with its options, e.g. Method('E', rings=2). "
+                       "bendlab.methods() lists them. Membrane parameters (docs/conventions.md §5): c0 (spontaneous "
+                       "curvature), ade_alpha, ade_d, ade_da0, ade_area (area-difference elasticity), e.g. "
+                       "Method('C', c0=1.0); defaults give the paper's energy. Method A refuses c0 and ADE.")
+      .def(py::init([](const std::string& name, const py::kwargs& kwargs) {
+             py::dict options(kwargs);  // a copy: the membrane parameters are taken out of it
+             const BendingParameters terms = terms_from(options);
+             PyMethod p{std::shared_ptr<const BendingMethod>(make_bending_method(name, options_from(options))), terms};
+             p.method->check_parameters(terms);
+             return p;
            }),
            py::arg("name"))
       .def_property_readonly("name", [](const PyMethod& p) { return p.method->name(); })
@@ -101,7 +132,8 @@ void bind_bending(py::module_& m) {
           [](const PyMethod& p, const TriMesh& mesh, double kappa_b) {
             require_kappa(kappa_b);
             py::gil_scoped_release release;
-            BendingResult r = p.method->compute(mesh.topology(), mesh.positions(), kappa_b);
+            BendingResult r = p.terms.plain() ? p.method->compute(mesh.topology(), mesh.positions(), kappa_b)
+                                              : p.method->compute(mesh.topology(), mesh.positions(), p.with(kappa_b));
             require_finite_result(r, p.method->name());
             return r;
           },
@@ -114,7 +146,10 @@ void bind_bending(py::module_& m) {
             Points f;
             {
               py::gil_scoped_release release;
-              p.method->forces(mesh.topology(), mesh.positions(), kappa_b, f);
+              if (p.terms.plain())
+                p.method->forces(mesh.topology(), mesh.positions(), kappa_b, f);
+              else
+                p.method->forces(mesh.topology(), mesh.positions(), p.with(kappa_b), f);
             }
             require_finite_rows(f, "method " + p.method->name() + ": F");
             return take(std::move(f));
@@ -124,7 +159,8 @@ void bind_bending(py::module_& m) {
           "energy",
           [](const PyMethod& p, const TriMesh& mesh, double kappa_b) {
             require_kappa(kappa_b);
-            return p.method->energy(mesh.topology(), mesh.positions(), kappa_b);
+            if (p.terms.plain()) return p.method->energy(mesh.topology(), mesh.positions(), kappa_b);
+            return p.method->energy(mesh.topology(), mesh.positions(), p.with(kappa_b));
           },
           py::arg("mesh"), py::arg("kappa_b") = 1.0, "E_B for energy-based methods (A, B, S), else None.")
       .def("__repr__", [](const PyMethod& p) { return "<bendlab.Method " + p.method->name() + ">"; })

@@ -138,3 +138,29 @@ def test_ten_thousand_calls_leave_the_resident_memory_bounded():
     # Each compute() allocates about 60 kB of results; a leak of one result per call would grow the
     # process by 300 MB. Allow allocator noise of a few MB.
     assert grown < 8 * 2**20, f"resident memory grew by {grown / 2**20:.1f} MiB over 10^4 calls"
+
+
+@pytest.mark.parametrize("name", ["B", "C", "J"])
+def test_membrane_parameters_equal_the_cli(name, rbc_1280, cli, tmp_path):
+    # c0 and ADE (docs/conventions.md §5): the same doubles as `bendlab forces --c0 ... --ade-*`.
+    out = tmp_path / "f.csv"
+    cli("forces", "--mesh", rbc_1280, "--method", name, "--c0", "0.75", "--ade-alpha", "2", "--ade-d", "0.02",
+        "--ade-da0", "0.1", "--ade-area", "8.4", "--out", out)
+    table = np.genfromtxt(out, delimiter=",", names=True)
+    mesh = bendlab.read_mesh(rbc_1280)
+    m = bendlab.Method(name, c0=0.75, ade_alpha=2, ade_d=0.02, ade_da0=0.1, ade_area=8.4)
+    r = m.compute(mesh)
+    np.testing.assert_array_equal(np.column_stack([table[c] for c in ("Fx", "Fy", "Fz")]), r.force)
+    np.testing.assert_array_equal(m.forces(mesh), r.force)
+    # The plain method differs, and c0 = 0 without ADE is the plain method exactly.
+    assert not np.array_equal(bendlab.Method(name).forces(mesh), r.force)
+    np.testing.assert_array_equal(bendlab.Method(name, c0=0.0).forces(mesh), bendlab.Method(name).forces(mesh))
+
+
+def test_membrane_parameters_are_refused_where_invalid():
+    with pytest.raises(ValueError, match="method A"):
+        bendlab.Method("A", c0=1.0)
+    with pytest.raises(ValueError, match="ade_area"):
+        bendlab.Method("C", ade_alpha=1.0, ade_d=0.1)
+    with pytest.raises(ValueError, match="finite"):
+        bendlab.Method("C", c0=float("nan"))

@@ -93,6 +93,10 @@ nlohmann::json to_json(const RbcStudyResult& s, const std::vector<ErrorRow>& row
   j["surface"] = "rbc";
   j["radius"] = s.options.radius;
   j["kappa_b"] = s.options.kappa_b;
+  if (s.options.c0 != 0 || s.options.ade_alpha != 0) {  // absent for the paper's study (files unchanged)
+    j["c0"] = s.options.c0;
+    j["ade"] = {{"alpha", s.options.ade_alpha}, {"d", s.options.ade_d}, {"dA0", s.options.ade_da0}};
+  }
   j["maxima"] = {{"H", s.maxima.H}, {"K", s.maxima.K}, {"lapH", s.maxima.lapH}, {"f", s.maxima.f}};
   j["options"] = {{"families", s.options.families},
                   {"methods", s.options.methods},

@@ -6,7 +6,9 @@
 #include <fmt/format.h>
 #include <set>
 
+#include "bendlab/bending/bending_parameters.hpp"
 #include "bendlab/geometry/measures.hpp"
+#include "bendlab/surfaces/surface_of_revolution.hpp"
 #include "bendlab/mesh/generators.hpp"
 
 namespace bendlab {
@@ -104,6 +106,15 @@ void validate(const RbcStudyOptions& o) {
     throw Error(fmt::format("kappa_b must be positive and finite, got {}", o.kappa_b));
   if (!(o.radius > 0) || !std::isfinite(o.radius))
     throw Error(fmt::format("radius must be positive and finite, got {}", o.radius));
+  {
+    // c0 / ADE: valid parameters, and every method able to take them (A is refused: §5).
+    BendingParameters p(o.kappa_b);
+    p.c0 = o.c0, p.ade_alpha = o.ade_alpha, p.ade_d = o.ade_d, p.ade_da0 = o.ade_da0;
+    p.ade_area = 1.0;  // the exact area, positive (rbc_bending_parameters)
+    p.validate();
+    if (!p.plain())
+      for (const std::string& m : o.methods) make_bending_method(m, options_for(o, m))->check_parameters(p);
+  }
   if (!(o.jitter >= 0) || !std::isfinite(o.jitter))
     throw Error(fmt::format("--jitter: the fraction must be finite and >= 0, got {}", o.jitter));
   // A fold is found only by making the mesh; the irregular meshes are cheap beside the study.
@@ -138,12 +149,33 @@ std::vector<ErrorRow> RbcStudyResult::rows() const {
   return rows;
 }
 
+BendingParameters rbc_bending_parameters(const RbcStudyOptions& o) {
+  BendingParameters p(o.kappa_b);
+  p.c0 = o.c0;
+  p.ade_alpha = o.ade_alpha;
+  p.ade_d = o.ade_d;
+  p.ade_da0 = o.ade_da0;
+  if (p.has_ade()) {
+    const auto rbc = make_rbc(o.radius);
+    p.ade_area = dynamic_cast<const SurfaceOfRevolution&>(*rbc).integrals().area;
+  }
+  return p;
+}
+
 RbcStudyResult run_rbc_study(const RbcStudyOptions& o) {
   validate(o);
   RbcStudyResult out;
   out.options = o;
   const auto rbc = make_rbc(o.radius);
   out.maxima = rbc->maxima(o.kappa_b);
+  const BendingParameters params = rbc_bending_parameters(o);
+  // With c0 / ADE: lambda of the exact shape and max|f| of the general force law.
+  double lambda = 0;
+  if (!params.plain()) {
+    const auto& rev = dynamic_cast<const SurfaceOfRevolution&>(*rbc);
+    lambda = params.ade_lambda(rev.integrals().mean_curvature);
+    out.maxima.f = rev.max_force_density(params.c0, params.kappa_b, lambda);
+  }
 
   std::vector<std::unique_ptr<BendingMethod>> methods;
   for (const std::string& m : o.methods) methods.push_back(make_bending_method(m, options_for(o, m)));
@@ -160,7 +192,14 @@ RbcStudyResult run_rbc_study(const RbcStudyOptions& o) {
     run.vertices = mesh.num_vertices();
     run.h = mean_edge_length(mesh.topology(), mesh.positions());
     run.has_nodes = run.inhomogeneous || run.triangles <= o.keep_nodes_max_triangles;
-    const SurfaceFields analytic = rbc->evaluate(mesh.positions(), o.kappa_b);
+    SurfaceFields analytic = rbc->evaluate(mesh.positions(), o.kappa_b);
+    if (!params.plain()) {
+      for (Eigen::Index i = 0; i < analytic.H.size(); ++i) {
+        analytic.f_normal[i] = membrane_normal_force(analytic.H[i], analytic.K[i], analytic.lapH[i], params.c0,
+                                                     params.kappa_b, lambda);
+        analytic.f.row(i) = analytic.f_normal[i] * analytic.normal.row(i);
+      }
+    }
     report(o, fmt::format("rbc: {} level {}{}: {} triangles, {} nodes, h = {:.5f}", run.family, spec.level,
                           spec.passes ? fmt::format(" + {} Rivara passes", spec.passes) : "", run.triangles,
                           run.vertices, run.h));
@@ -170,7 +209,7 @@ RbcStudyResult run_rbc_study(const RbcStudyOptions& o) {
       const auto t0 = std::chrono::steady_clock::now();
       BendingResult result;
       try {
-        result = method->compute(mesh.topology(), mesh.positions(), o.kappa_b);
+        result = method->compute(mesh.topology(), mesh.positions(), params);
       } catch (const Error& e) {
         if (!bending_method_info(mr.method).capabilities.needs_admissible_mesh) throw;
         mr.refused = e.what();

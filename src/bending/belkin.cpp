@@ -673,6 +673,12 @@ MethodInfo BelkinMethod::info() {
 }
 
 BendingResult BelkinMethod::compute(const Topology& topology, const Points& x, double kappa_b) const {
+  return compute_terms(topology, x, BendingParameters(kappa_b));  // plain: eq. (10) unchanged
+}
+
+// With c0 and ADE the force law of docs/conventions.md §5 from the same H, K, Lap H and n.
+BendingResult BelkinMethod::compute_terms(const Topology& topology, const Points& x,
+                                          const BendingParameters& params) const {
   const MeshGeometry g = MeshGeometry::compute(topology, x);
   const BelkinLaplacian lap(topology, x, g, options_);
   // eq. (2) with eq. (13): Lap x = -2 H n.
@@ -682,7 +688,7 @@ BendingResult BelkinMethod::compute(const Topology& topology, const Points& x, d
   for (int i = 0; i < topology.num_vertices(); ++i) H[i] = -0.5 * lap_x.row(i).dot(g.normal_mwa.row(i));
   Scalars lapH = lap.apply(H);  // eq. (13) applied to H
   return assemble_variational_result(g.normal_mwa, std::move(H), g.gaussian_curvature, std::move(lapH),
-                                     g.mixed_area, kappa_b);
+                                     g.mixed_area, params);
 }
 
 }  // namespace bendlab

@@ -271,13 +271,19 @@ MethodInfo FarutinMethod::info() {
 }
 
 BendingResult FarutinMethod::compute(const Topology& topology, const Points& x, double kappa_b) const {
+  return compute_terms(topology, x, BendingParameters(kappa_b));  // plain: eq. (10) unchanged
+}
+
+// With c0 and ADE the force law of docs/conventions.md §5 from the same H, K, Lap H and n.
+BendingResult FarutinMethod::compute_terms(const Topology& topology, const Points& x,
+                                           const BendingParameters& params) const {
   const MeshGeometry geometry = MeshGeometry::compute(topology, x);
   const std::vector<FarutinFit> fits = farutin_fit(topology, x, geometry.normal_mwa, rings_);
   require_valid_fits(fits, "E");
   FarutinFields e = farutin_fields(fits);
   Scalars lapH = farutin_laplacian(topology, x, fits, e.H);
   return assemble_variational_result(std::move(e.normal), std::move(e.H), std::move(e.K), std::move(lapH),
-                                     geometry.mixed_area, kappa_b);
+                                     geometry.mixed_area, params);
 }
 
 }  // namespace bendlab

@@ -19,12 +19,13 @@ constexpr int kParallelMinFaces = 4096;
 struct VertexSums {
   Points S;
   Scalars D;
+  Scalars m;  ///< with c0 / ADE only: m_i = H_i A_i = sign(S_i . N_i) |S_i| / 4
 };
 
 // Scratch arrays of the kernel, kept per calling thread and reused from call to call, so a time
 // loop does not allocate (and page in) fresh memory at every step.
 struct Workspace {
-  std::vector<double> half_T, us, corner_grad;
+  std::vector<double> half_T, us, corner_grad, m;
 };
 
 // The energy E = kB sum_i |S_i|^2 / D_i (eqs. (A.1)-(A.2)), optionally its gradient and the sums.
@@ -53,7 +54,19 @@ struct Workspace {
 // Every loop writes only to its own element (faces: their corners and their edge slots;
 // vertices: themselves, gathering over their one-ring), so each runs in parallel without write
 // conflicts.
-double gk_kernel(const Topology& t, const Points& x, double kappa_b, Points* force, VertexSums* sums) {
+//
+// With c0 and ADE (docs/conventions.md §5), E = 2 kB sum_i (H_i - c0)^2 A_i + E_ADE(M) with the
+// signed H_i = sigma_i |S_i| / (4 A_i), sigma_i = sign(S_i . N_i), N_i the area-weighted vertex
+// normal (sum of the ring's face normals), and M = sum_i H_i A_i = sum_i sigma_i |S_i| / 4. sigma is
+// piecewise constant, so no derivative of a normal appears (Bian et al. 2020 use S_i . n_i with a
+// normal they do not differentiate; sigma |S_i| is the same where S_i is parallel to n_i):
+//   E~_i = 2 |S_i|^2 / D_i - 2 c0 sigma_i |S_i| + c0^2 D_i / 2,   E = kB/2 sum_i E~_i + E_ADE,
+// so only u_i and s_i of the derivation above change:
+//   u_i = 4 S_i / D_i + (lambda / (2 kB) - 2 c0) sigma_i S_i / |S_i|,   s_i = 2 |S_i|^2 / D_i^2 - c0^2 / 2,
+// lambda / kB = alpha pi (M - M0) / A. Plain parameters keep the expressions above.
+double gk_kernel(const Topology& t, const Points& x, const BendingParameters& p, Points* force, VertexSums* sums) {
+  const double kappa_b = p.kappa_b;
+  const bool plain = p.plain();
   const int nf = t.num_faces(), nv = t.num_vertices(), ne = t.num_edges();
   const Faces& F = t.faces();
   const Faces& FE = t.face_edges();
@@ -78,6 +91,11 @@ double gk_kernel(const Topology& t, const Points& x, double kappa_b, Points* for
     sums->S.resize(nv, 3);
     sums->D.resize(nv);
   }
+  // With c0 / ADE: m_i (nv), S_i (3 nv), D_i (nv).
+  if (!plain) ws.m.resize(5 * static_cast<size_t>(nv));
+  if (sums && !plain) sums->m.resize(nv);
+  double* mh = ws.m.data();
+  double energy_terms = 0;
   double* half_T = ws.half_T.data();
   double* us = ws.us.data();
   double* corner_grad = ws.corner_grad.data();
@@ -117,6 +135,38 @@ double gk_kernel(const Topology& t, const Points& x, double kappa_b, Points* for
       if (sums) {
         sums->S.row(i) = S.transpose();
         sums->D[i] = D;
+      }
+      if (!plain) {
+        Vec3 N = Vec3::Zero();  // area-weighted normal (times 2)
+        for (int r = roff[i]; r < roff[i + 1]; ++r) {
+          const int f = rfaces[r];
+          const Vec3 p0 = xrow(x, F(f, 0));
+          N += (xrow(x, F(f, 1)) - p0).cross(xrow(x, F(f, 2)) - p0);
+        }
+        const double sn = std::sqrt(S2);
+        mh[i] = (S.dot(N) < 0 ? -0.25 : 0.25) * sn;
+        for (int c = 0; c < 3; ++c) mh[nv + 3 * i + c] = S[c];
+        mh[4 * nv + i] = D;
+      }
+    }
+    if (!plain) {
+#pragma omp single
+      {
+        double mtot = 0, et = 0;
+        for (int i = 0; i < nv; ++i) mtot += mh[i];
+        const double lk = p.has_ade() ? p.ade_alpha * M_PI * (mtot - p.ade_m0()) / p.ade_area : 0.0;
+        for (int i = 0; i < nv; ++i) {
+          const double D = mh[4 * nv + i];
+          const Vec3 S(mh[nv + 3 * i], mh[nv + 3 * i + 1], mh[nv + 3 * i + 2]);
+          const double sn = S.norm();
+          const double sigma = mh[i] < 0 ? -1.0 : 1.0;
+          et += 2.0 * sn * sn / D - 2.0 * p.c0 * sigma * sn + 0.5 * p.c0 * p.c0 * D;
+          const double cu = sn > 0 ? (0.5 * lk - 2.0 * p.c0) * sigma / sn : 0.0;
+          for (int c = 0; c < 3; ++c) us[4 * i + c] += cu * S[c];
+          us[4 * i + 3] -= 0.5 * p.c0 * p.c0;
+          if (sums) sums->m[i] = mh[i];
+        }
+        energy_terms = 0.5 * kappa_b * et + p.ade_energy(mtot);
       }
     }
     if (force) {
@@ -174,7 +224,7 @@ double gk_kernel(const Topology& t, const Points& x, double kappa_b, Points* for
       }
     }
   }
-  return kappa_b * energy;
+  return plain ? kappa_b * energy : energy_terms;
 }
 
 }  // namespace
@@ -193,18 +243,30 @@ MethodInfo GompperKroll::info() {
 }
 
 void GompperKroll::forces(const Topology& t, const Points& x, double kappa_b, Points& force) const {
-  gk_kernel(t, x, kappa_b, &force, nullptr);
+  gk_kernel(t, x, BendingParameters(kappa_b), &force, nullptr);
 }
 
 std::optional<double> GompperKroll::energy(const Topology& t, const Points& x, double kappa_b) const {
-  return gk_kernel(t, x, kappa_b, nullptr, nullptr);
+  return gk_kernel(t, x, BendingParameters(kappa_b), nullptr, nullptr);
 }
 
 BendingResult GompperKroll::compute(const Topology& t, const Points& x, double kappa_b) const {
+  return compute_terms(t, x, BendingParameters(kappa_b));
+}
+
+void GompperKroll::forces_terms(const Topology& t, const Points& x, const BendingParameters& p, Points& force) const {
+  gk_kernel(t, x, p, &force, nullptr);
+}
+
+std::optional<double> GompperKroll::energy_terms(const Topology& t, const Points& x, const BendingParameters& p) const {
+  return gk_kernel(t, x, p, nullptr, nullptr);
+}
+
+BendingResult GompperKroll::compute_terms(const Topology& t, const Points& x, const BendingParameters& p) const {
   const int nv = t.num_vertices();
   BendingResult r;
   VertexSums sums;
-  r.energy = gk_kernel(t, x, kappa_b, &r.force, &sums);
+  r.energy = gk_kernel(t, x, p, &r.force, &sums);
   MeshGeometry g = MeshGeometry::compute(t, x);
   r.H.resize(nv);
   r.force_density.resize(nv, 3);
@@ -212,7 +274,10 @@ BendingResult GompperKroll::compute(const Topology& t, const Points& x, double k
     // |S_i| / (4 A_i) with 4 A_i = D_i / 2 (eq. (9)); the sign of S_i . n_i is that of
     // -1/2 (Lap x)_i . n_i, because S_i = -2 A_i (Lap x)_i with the div-grad Laplacian.
     const double magnitude = 2.0 * sums.S.row(i).norm() / sums.D[i];
-    r.H[i] = sums.S.row(i).dot(g.normal_mwa.row(i)) < 0 ? -magnitude : magnitude;
+    if (p.plain())
+      r.H[i] = sums.S.row(i).dot(g.normal_mwa.row(i)) < 0 ? -magnitude : magnitude;
+    else  // the sign the energy uses (area-weighted normal, see gk_kernel)
+      r.H[i] = sums.m[i] < 0 ? -magnitude : magnitude;
     r.force_density.row(i) = r.force.row(i) / g.mixed_area[i];  // eq. (14)
   }
   r.area = std::move(g.mixed_area);

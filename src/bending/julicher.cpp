@@ -36,7 +36,15 @@ struct Sums {
 //   dtheta/da   = sum_k (1 - t_k) n_k / h_k,   dtheta/db = sum_k t_k n_k / h_k,
 // with t_k = (o_k - a) . (b - a) / l^2 the foot of o_k's height on the edge (the four gradients
 // sum to zero, and the rotation about the edge leaves no torque).
-double kernel(const Topology& t, const Points& x, double kappa_b, Points* force, Sums* sums_out) {
+//
+// With c0 and ADE (docs/conventions.md §5): E = 2 kB sum_i (H_i - c0)^2 A_i + E_ADE(M), with the
+// discrete M = sum_i H_i A_i = 1/4 sum_i M_i = 1/2 sum_e l_e theta_e, so only the weights change:
+//   alpha_i = kB (H_i - c0) + lambda / 4,   beta_i = 2 kB (H_i^2 - c0^2),
+// lambda = alpha pi kB (M - M0) / A (BendingParameters::ade_lambda). Plain parameters keep the
+// expressions above, operation for operation.
+double kernel(const Topology& t, const Points& x, const BendingParameters& p, Points* force, Sums* sums_out) {
+  const double kappa_b = p.kappa_b;
+  const bool plain = p.plain();
   const int nf = t.num_faces(), nv = t.num_vertices(), ne = t.num_edges();
   const Faces& F = t.faces();
   const IndexPairs& EV = t.edge_vertices();
@@ -87,6 +95,24 @@ double kernel(const Topology& t, const Points& x, double kappa_b, Points* force,
       energy += kappa_b / 8.0 * m * m / s.A[i];
     }
   }
+  // The weights alpha_i, beta_i with c0 and ADE (unused when plain).
+  Scalars alpha, beta;
+  if (!plain) {
+    energy = 0;
+    double mtot = 0;
+    alpha.resize(nv);
+    beta.resize(nv);
+    for (int i = 0; i < nv; ++i) {
+      const double h = s.M[i] / (4.0 * s.A[i]);
+      energy += 2.0 * kappa_b * (h - p.c0) * (h - p.c0) * s.A[i];
+      mtot += 0.25 * s.M[i];
+      alpha[i] = kappa_b * (h - p.c0);
+      beta[i] = 2.0 * kappa_b * (h * h - p.c0 * p.c0);
+    }
+    energy += p.ade_energy(mtot);
+    const double lambda4 = 0.25 * p.ade_lambda(mtot);
+    alpha.array() += lambda4;
+  }
   if (force != nullptr) {
     force->resize(nv, 3);
     // Per edge: the weighted gradient of l_e theta_e w.r.t. a, b, o0, o1 (dE terms of the edge).
@@ -96,6 +122,10 @@ double kernel(const Topology& t, const Points& x, double kappa_b, Points* force,
     {
 #pragma omp for schedule(static)
       for (int f = 0; f < nf; ++f) {
+        if (!plain) {
+          gface[f] = (beta[F(f, 0)] + beta[F(f, 1)] + beta[F(f, 2)]) / 3.0;  // g_f
+          continue;
+        }
         double b = 0;
         for (int k = 0; k < 3; ++k) {
           const int v = F(f, k);
@@ -107,7 +137,8 @@ double kernel(const Topology& t, const Points& x, double kappa_b, Points* force,
 #pragma omp for schedule(static)
       for (int e = 0; e < ne; ++e) {
         const int a = EV(e, 0), b = EV(e, 1);
-        const double w = kappa_b / 4.0 * (s.M[a] / s.A[a] + s.M[b] / s.A[b]);  // w_e
+        const double w = plain ? kappa_b / 4.0 * (s.M[a] / s.A[a] + s.M[b] / s.A[b])  // w_e
+                               : alpha[a] + alpha[b];
         const Vec3 pa = xrow(x, a), pb = xrow(x, b), d = pb - pa;
         const double l = len[e], l2 = l * l;
         Vec3 da = Vec3::Zero(), db = Vec3::Zero(), dok[2];
@@ -166,18 +197,32 @@ MethodInfo JulicherMethod::info() {
 }
 
 void JulicherMethod::forces(const Topology& t, const Points& x, double kappa_b, Points& force) const {
-  kernel(t, x, kappa_b, &force, nullptr);
+  kernel(t, x, BendingParameters(kappa_b), &force, nullptr);
 }
 
 std::optional<double> JulicherMethod::energy(const Topology& t, const Points& x, double kappa_b) const {
-  return kernel(t, x, kappa_b, nullptr, nullptr);
+  return kernel(t, x, BendingParameters(kappa_b), nullptr, nullptr);
 }
 
 BendingResult JulicherMethod::compute(const Topology& t, const Points& x, double kappa_b) const {
+  return compute_terms(t, x, BendingParameters(kappa_b));
+}
+
+void JulicherMethod::forces_terms(const Topology& t, const Points& x, const BendingParameters& p,
+                                  Points& force) const {
+  kernel(t, x, p, &force, nullptr);
+}
+
+std::optional<double> JulicherMethod::energy_terms(const Topology& t, const Points& x,
+                                                   const BendingParameters& p) const {
+  return kernel(t, x, p, nullptr, nullptr);
+}
+
+BendingResult JulicherMethod::compute_terms(const Topology& t, const Points& x, const BendingParameters& p) const {
   const int nv = t.num_vertices();
   BendingResult r;
   Sums s;
-  r.energy = kernel(t, x, kappa_b, &r.force, &s);
+  r.energy = kernel(t, x, p, &r.force, &s);
   MeshGeometry g = MeshGeometry::compute(t, x);
   r.H.resize(nv);
   r.K.resize(nv);

@@ -35,6 +35,15 @@ std::unique_ptr<BendingMethod> KantorNelson::create(const MethodOptions& options
   return std::make_unique<KantorNelson>(option_bool(o, "small_angle"));
 }
 
+std::string KantorNelson::membrane_terms_refusal() const {
+  // A preferred dihedral angle theta0 (E_e = 2 kB~ (1 - cos(theta - theta0))) is the usual way to
+  // give eq. (6) a spontaneous curvature, but theta0 = f(c0, edge length) only has a continuum
+  // limit on a tiling of equal equilateral triangles, and eq. (6) itself converges to a
+  // triangulation-dependent energy (header); there is no discrete integral of H to build ADE on.
+  return "Kantor-Nelson's dihedral energy has no mesh-independent preferred angle for a spontaneous "
+         "curvature and no integral of H for ADE";
+}
+
 MethodInfo KantorNelson::info() {
   MethodInfo m{"A", "Kantor-Nelson: gradient of the dihedral-angle energy, eq. (6)",
                 {bool_option("small_angle", false, "small-angle form theta^2/2 of 1 - cos(theta)")}, {},

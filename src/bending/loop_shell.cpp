@@ -127,26 +127,43 @@ Points LoopShellMethod::control_points(const Topology& topology, const Points& x
   return cache->limit_solver->solve(x);
 }
 
-double LoopShellMethod::control_energy(const Topology& topology, const Points& control, double kappa_b,
-                                       Points* gradient) const {
-  auto cache = cache_for(topology);
-  return loop_shell::shell_energy(cache->patches, cache->bases, control, kappa_b, gradient);
+loop_shell::ShellTerms LoopShellMethod::shell_terms(Cache& cache, const Points& control, const BendingParameters& p,
+                                                    double* ade_energy) const {
+  *ade_energy = 0;
+  if (p.plain()) return loop_shell::ShellTerms(p.kappa_b);
+  double lambda = 0;
+  if (p.has_ade()) {
+    const double m = loop_shell::shell_mean_curvature_integral(cache.patches, cache.bases, control);
+    lambda = p.ade_lambda(m);
+    *ade_energy = p.ade_energy(m);
+  }
+  return loop_shell::ShellTerms(p.kappa_b, p.c0, lambda);
 }
 
-LoopShellState LoopShellMethod::state(const Topology& topology, const Points& x, double kappa_b) const {
+double LoopShellMethod::control_energy(const Topology& topology, const Points& control, const BendingParameters& p,
+                                       Points* gradient) const {
+  auto cache = cache_for(topology);
+  double ade = 0;
+  const loop_shell::ShellTerms terms = shell_terms(*cache, control, p, &ade);
+  return loop_shell::shell_energy(cache->patches, cache->bases, control, terms, gradient) + ade;
+}
+
+LoopShellState LoopShellMethod::state(const Topology& topology, const Points& x, const BendingParameters& p) const {
   auto cache = cache_for(topology);
   LoopShellState s;
   s.control = control_points(topology, x);
   Points gradient;
   SparseMatrix m = cache->mass.pattern();
+  double ade = 0;
+  const loop_shell::ShellTerms terms = shell_terms(*cache, s.control, p, &ade);
   s.energy = loop_shell::shell_energy_mass(cache->patches, cache->bases, cache->mass, cache->colouring, s.control,
-                                           kappa_b, gradient, m);
+                                           terms, gradient, m) + ade;
   s.control_force = -gradient;
   s.force_coefficients = solve_mass(*cache, m, Eigen::MatrixXd(s.control_force));
   return s;
 }
 
-BendingResult LoopShellMethod::evaluate(const Topology& topology, const Points& x, double kappa_b,
+BendingResult LoopShellMethod::evaluate(const Topology& topology, const Points& x, const BendingParameters& p,
                                         bool nodal_geometry) const {
   auto cache = cache_for(topology);
   const int nv = topology.num_vertices();
@@ -156,8 +173,11 @@ BendingResult LoopShellMethod::evaluate(const Topology& topology, const Points& 
   const bool project_h = nodal_geometry && h_mode_ == HMode::Projection;
   SparseMatrix m = cache->mass.pattern();
   Eigen::VectorXd h_rhs;
+  double ade = 0;
+  const loop_shell::ShellTerms terms = shell_terms(*cache, control, p, &ade);
   r.energy = loop_shell::shell_energy_mass(cache->patches, cache->bases, cache->mass, cache->colouring, control,
-                                           kappa_b, gradient, m, project_h ? &h_rhs : nullptr);
+                                           terms, gradient, m, project_h ? &h_rhs : nullptr);
+  if (!p.plain()) *r.energy += ade;
   Eigen::MatrixXd rhs(nv, project_h ? 4 : 3);
   rhs.leftCols(3) = -gradient;
   if (project_h) rhs.col(3) = h_rhs;
@@ -207,6 +227,21 @@ void LoopShellMethod::forces(const Topology& topology, const Points& x, double k
 
 std::optional<double> LoopShellMethod::energy(const Topology& topology, const Points& x, double kappa_b) const {
   return control_energy(topology, control_points(topology, x), kappa_b);
+}
+
+BendingResult LoopShellMethod::compute_terms(const Topology& topology, const Points& x,
+                                             const BendingParameters& p) const {
+  return evaluate(topology, x, p, true);
+}
+
+void LoopShellMethod::forces_terms(const Topology& topology, const Points& x, const BendingParameters& p,
+                                   Points& force) const {
+  force = evaluate(topology, x, p, false).force;
+}
+
+std::optional<double> LoopShellMethod::energy_terms(const Topology& topology, const Points& x,
+                                                    const BendingParameters& p) const {
+  return control_energy(topology, control_points(topology, x), p);
 }
 
 }  // namespace bendlab

@@ -64,7 +64,7 @@ FaceColouring FaceColouring::build(const LoopPatches& patches, int num_points, i
 }
 
 double shell_energy_mass(const LoopPatches& patches, const QuadratureBases& bases, const MassPattern& mass,
-                         const FaceColouring& colouring, const Points& control, double kappa_b, Points& gradient,
+                         const FaceColouring& colouring, const Points& control, const ShellTerms& terms, Points& gradient,
                          Eigen::SparseMatrix<double>& m, Eigen::VectorXd* h_rhs, int parallel_faces) {
   gradient.setZero(control.rows(), 3);
   double* values = m.valuePtr();
@@ -88,7 +88,7 @@ double shell_energy_mass(const LoopPatches& patches, const QuadratureBases& base
         const int f = colouring.faces[k];
         const int* idx = patches.face_points(f);
         const int* slot = mass.face_slots(f);
-        if (face_energy_fast(bases, patches.valence[f], control, idx, kappa_b, h_rhs != nullptr, work, energy)) {
+        if (face_energy_fast(bases, patches.valence[f], control, idx, terms, h_rhs != nullptr, work, energy)) {
           const int n = work.m;
           const double* upper = work.mass;
           for (int a = 0; a < n; ++a) {
@@ -102,7 +102,7 @@ double shell_energy_mass(const LoopPatches& patches, const QuadratureBases& base
           }
           continue;
         }
-        energy += face_energy(bases.at(patches.valence[f]), rule, control, idx, kappa_b, &local);
+        energy += face_energy(bases.at(patches.valence[f]), rule, control, idx, terms, &local);
         const int n = static_cast<int>(local.gradient.rows());
         for (int a = 0; a < n; ++a) {
           gradient.row(idx[a]) += local.gradient.row(a);

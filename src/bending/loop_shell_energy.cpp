@@ -46,7 +46,7 @@ Geometry geometry(const Derivs& d) {
 
 // Coefficients of N_I, N_I,v .. N_I,ww (rows) in w dE/dP_I at one point (row kValue is zero), with
 // w = 2 kB w_q (see the header).
-Derivs gradient_coefficients(const Geometry& s, double wq) {
+Derivs gradient_coefficients(const Geometry& s, double wq, const ShellTerms& terms, double wr) {
   // b^ab = a^ag b_gd a^db and m_b = b^ab a_a; c^g = a^ab Gamma^g_ab.
   const double bl[2][2] = {{s.bl[0], s.bl[1]}, {s.bl[1], s.bl[2]}};
   double bu[2][2] = {};
@@ -56,7 +56,12 @@ Derivs gradient_coefficients(const Geometry& s, double wq) {
         for (int l = 0; l < 2; ++l) bu[i][j] += s.g[i][k] * bl[k][l] * s.g[l][j];
   const Vec3 xab = s.g[0][0] * s.xdd[0] + 2.0 * s.g[0][1] * s.xdd[1] + s.g[1][1] * s.xdd[2];  // a^ab x_,ab
   const double c1 = s.dual[0].dot(xab), c2 = s.dual[1].dot(xab);
-  const double hj = wq * s.H * s.J, h2j = wq * s.H * s.H * s.J;
+  double hj = wq * s.H * s.J, h2j = wq * s.H * s.H * s.J;
+  if (!terms.plain) {  // c0 and ADE (ShellTerms); wr = w_q without 2 kB
+    const double dh = s.H - terms.c0;
+    hj = (wq * dh + 0.5 * terms.lambda * wr) * s.J;
+    h2j = (wq * dh * dh + terms.lambda * wr * s.H) * s.J;
+  }
   // Coefficients of N_I,v .. N_I,ww in dE/dP_I (see the header).
   Derivs qm;
   qm.row(kValue).setZero();
@@ -106,7 +111,7 @@ namespace {
 
 // face_energy_fast for patches of M = N + 6 control points.
 template <int M>
-void face_fast(const QuadratureBases& bases, int valence, const Points& control, const int* idx, double kappa_b,
+void face_fast(const QuadratureBases& bases, int valence, const Points& control, const int* idx, const ShellTerms& terms,
                bool with_h, FaceWork& work, double& energy) {
   using Basis = Eigen::Matrix<double, 6, M>;
   using Local = Eigen::Matrix<double, M, 3>;
@@ -125,11 +130,11 @@ void face_fast(const QuadratureBases& bases, int valence, const Points& control,
     // kernels, which it would pick from 20 rows + columns + depth on.
     const Derivs d = b.lazyProduct(p);
     const Geometry s = geometry(d);
-    const double wq = 0.5 * rule.weight[q] * 2.0 * kappa_b;  // 2 kB w_q
-    energy += wq * s.H * s.H * s.J;
+    const double wq = 0.5 * rule.weight[q] * 2.0 * terms.kappa_b;  // 2 kB w_q
+    energy += terms.plain ? wq * s.H * s.H * s.J : wq * (s.H - terms.c0) * (s.H - terms.c0) * s.J;
     wj[q] = 0.5 * rule.weight[q] * s.J;
     if (with_h) h.noalias() += (wj[q] * s.H) * b.row(kValue).transpose();
-    const Derivs qm = gradient_coefficients(s, wq);
+    const Derivs qm = gradient_coefficients(s, wq, terms, 0.5 * rule.weight[q]);
     g.noalias() += b.template bottomRows<5>().transpose().lazyProduct(qm.template bottomRows<5>());
   }
   work.m = M;
@@ -146,14 +151,14 @@ void face_fast(const QuadratureBases& bases, int valence, const Points& control,
 }  // namespace
 
 bool face_energy_fast(const QuadratureBases& bases, int valence, const Points& control, const int* idx,
-                      double kappa_b, bool with_h, FaceWork& work, double& energy) {
+                      const ShellTerms& terms, bool with_h, FaceWork& work, double& energy) {
   switch (valence) {
-    case 3: face_fast<9>(bases, valence, control, idx, kappa_b, with_h, work, energy); return true;
-    case 4: face_fast<10>(bases, valence, control, idx, kappa_b, with_h, work, energy); return true;
-    case 5: face_fast<11>(bases, valence, control, idx, kappa_b, with_h, work, energy); return true;
-    case 6: face_fast<12>(bases, valence, control, idx, kappa_b, with_h, work, energy); return true;
-    case 7: face_fast<13>(bases, valence, control, idx, kappa_b, with_h, work, energy); return true;
-    case 8: face_fast<14>(bases, valence, control, idx, kappa_b, with_h, work, energy); return true;
+    case 3: face_fast<9>(bases, valence, control, idx, terms, with_h, work, energy); return true;
+    case 4: face_fast<10>(bases, valence, control, idx, terms, with_h, work, energy); return true;
+    case 5: face_fast<11>(bases, valence, control, idx, terms, with_h, work, energy); return true;
+    case 6: face_fast<12>(bases, valence, control, idx, terms, with_h, work, energy); return true;
+    case 7: face_fast<13>(bases, valence, control, idx, terms, with_h, work, energy); return true;
+    case 8: face_fast<14>(bases, valence, control, idx, terms, with_h, work, energy); return true;
     default: return false;
   }
 }
@@ -173,7 +178,7 @@ SurfacePoint surface_point(const PatchBasis& basis, const Points& control, const
 }
 
 double face_energy(const std::vector<PatchBasis>& basis, const TriangleRule& rule, const Points& control,
-                   const int* idx, double kappa_b, FaceLocal* local) {
+                   const int* idx, const ShellTerms& terms, FaceLocal* local) {
   const int m = static_cast<int>(basis.front().cols());
   if (local) {
     local->gradient.setZero(m, 3);
@@ -183,8 +188,8 @@ double face_energy(const std::vector<PatchBasis>& basis, const TriangleRule& rul
   double energy = 0.0;
   for (int q = 0; q < rule.size(); ++q) {
     const Geometry s = geometry(derivatives(basis[q], control, idx));
-    const double wq = 0.5 * rule.weight[q] * 2.0 * kappa_b;  // 2 kB w_q
-    energy += wq * s.H * s.H * s.J;
+    const double wq = 0.5 * rule.weight[q] * 2.0 * terms.kappa_b;  // 2 kB w_q
+    energy += terms.plain ? wq * s.H * s.H * s.J : wq * (s.H - terms.c0) * (s.H - terms.c0) * s.J;
     if (!local) continue;
     if (local->with_mass || local->with_h) {
       const double wj = 0.5 * rule.weight[q] * s.J;
@@ -192,25 +197,38 @@ double face_energy(const std::vector<PatchBasis>& basis, const TriangleRule& rul
       if (local->with_mass) local->mass.noalias() += (wj * n.transpose()) * n;
       if (local->with_h) local->h.noalias() += (wj * s.H) * n.transpose();
     }
-    const Derivs qm = gradient_coefficients(s, wq);
+    const Derivs qm = gradient_coefficients(s, wq, terms, 0.5 * rule.weight[q]);
     local->gradient.noalias() += basis[q].transpose() * qm;
   }
   return energy;
 }
 
 double shell_energy(const LoopPatches& patches, const QuadratureBases& bases, const Points& control,
-                    double kappa_b, Points* gradient) {
+                    const ShellTerms& terms, Points* gradient) {
   if (gradient) gradient->setZero(control.rows(), 3);
   double energy = 0.0;
   FaceLocal local;
   for (int f = 0; f < patches.num_faces(); ++f) {
     const int* idx = patches.face_points(f);
-    energy += face_energy(bases.at(patches.valence[f]), bases.rule(), control, idx, kappa_b,
+    energy += face_energy(bases.at(patches.valence[f]), bases.rule(), control, idx, terms,
                           gradient ? &local : nullptr);
     if (gradient)
       for (int i = 0; i < local.gradient.rows(); ++i) gradient->row(idx[i]) += local.gradient.row(i);
   }
   return energy;
+}
+
+double shell_mean_curvature_integral(const LoopPatches& patches, const QuadratureBases& bases, const Points& control) {
+  const TriangleRule& rule = bases.rule();
+  double m = 0.0;
+  for (int f = 0; f < patches.num_faces(); ++f) {
+    const auto& basis = bases.at(patches.valence[f]);
+    for (int q = 0; q < rule.size(); ++q) {
+      const SurfacePoint s = surface_point(basis[q], control, patches.face_points(f));
+      m += 0.5 * rule.weight[q] * s.H * s.J;
+    }
+  }
+  return m;
 }
 
 double shell_area(const LoopPatches& patches, const QuadratureBases& bases, const Points& control) {

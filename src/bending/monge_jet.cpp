@@ -415,6 +415,12 @@ MethodInfo MongeJetMethod::info() {
 }
 
 BendingResult MongeJetMethod::compute(const Topology& topology, const Points& x, double kappa_b) const {
+  return compute_terms(topology, x, BendingParameters(kappa_b));  // plain: eq. (10) unchanged
+}
+
+// With c0 and ADE the force law of docs/conventions.md §5 from the same H, K, Lap H and n.
+BendingResult MongeJetMethod::compute_terms(const Topology& topology, const Points& x,
+                                            const BendingParameters& params) const {
   const MeshGeometry geometry = MeshGeometry::compute(topology, x);
   const std::vector<MongeJetFit> fits = monge_jet_fit(topology, x, geometry.normal_mwa, settings_, *supports_for(topology));
   const auto n = static_cast<Eigen::Index>(fits.size());
@@ -427,7 +433,7 @@ BendingResult MongeJetMethod::compute(const Topology& topology, const Points& x,
     lapH[i] = fits[i].lapH;
   }
   return assemble_variational_result(std::move(normal), std::move(H), std::move(K), std::move(lapH),
-                                     geometry.mixed_area, kappa_b);
+                                     geometry.mixed_area, params);
 }
 
 }  // namespace bendlab

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bendlab/bending/method_registry.hpp"
+#include "bendlab/geometry/measures.hpp"
 #include "bendlab/capsule/run_tolerances.hpp"
 #include "bendlab/capsule/shear_units.hpp"
 #include "bendlab/core/file_input.hpp"
@@ -107,11 +108,27 @@ CapsuleRunResult run_shear(const ShearRunSpec& a, const ShearRunCallbacks& callb
     throw Error(fmt::format("--resume: no checkpoint in '{}' to resume from", a.folder.string()));
   if (a.resume) check_resumed_membrane(a);
   const TriMesh mesh = mesh_from_spec(a.mesh);
+  // c0 and ADE (docs/conventions.md §5), in units of R = 1; A defaults to the initial area.
+  BendingParameters terms(1.0);
+  terms.c0 = a.c0;
+  terms.ade_alpha = a.ade_alpha;
+  terms.ade_d = a.ade_d;
+  terms.ade_da0 = a.ade_da0;
+  if (terms.ade_alpha == 0 && (a.ade_d != 0 || a.ade_da0 != 0 || a.ade_area))
+    throw Error("--ade-d, --ade-da0 and --ade-area need --ade-alpha > 0");
+  if (terms.has_ade()) terms.ade_area = a.ade_area ? *a.ade_area : surface_area(mesh.topology(), mesh.positions());
+  terms.validate();
+  if (!terms.plain() && (a.method == "none" || !(units.kappa_b_hat > 0)))
+    throw Error("--c0 and --ade-alpha need a bending --method and --kappa-b-hat (or --kappa-b) > 0");
   if (bending) {
+    bending->check_parameters(terms);
     // One evaluation on the initial shape, so that a mesh the method refuses (Method S: two
     // extraordinary vertices in a triangle) fails here, before the run folder is written.
     Points probe;
-    bending->forces(mesh.topology(), mesh.positions(), 1.0, probe);
+    if (terms.plain())
+      bending->forces(mesh.topology(), mesh.positions(), 1.0, probe);
+    else
+      bending->forces(mesh.topology(), mesh.positions(), terms, probe);
   }
   if (!tolerance_warning.empty() && callbacks.on_note) callbacks.on_note("warning: " + tolerance_warning);
 
@@ -119,6 +136,7 @@ CapsuleRunResult run_shear(const ShearRunSpec& a, const ShearRunCallbacks& callb
   mp.kS = units.kS();
   mp.kB = units.kB();
   mp.bending = bending;
+  mp.bending_terms = terms;
   mp.elastic_law = a.membrane;
   mp.skalak_c = a.skalak_c;
   std::unique_ptr<CapsuleSolver> solver;
@@ -229,6 +247,10 @@ CapsuleRunResult run_shear(const ShearRunSpec& a, const ShearRunCallbacks& callb
   }
   // Likewise the quadrature: runs of the reference (all7) keep the identity they always had.
   if (a.bim_quadrature != "all7") o.arguments["bim_quadrature"] = a.bim_quadrature;
+  // Likewise c0 and ADE: part of the identity only when used.
+  if (terms.has_c0()) o.arguments["c0"] = terms.c0;
+  if (terms.has_ade())
+    o.arguments["ade"] = {{"alpha", terms.ade_alpha}, {"d", terms.ade_d}, {"dA0", terms.ade_da0}, {"A", terms.ade_area}};
   for (const auto& [key, value] : lattice_arguments.items()) o.arguments[key] = value;
   summary_fields["membrane_law"] = a.membrane;
   if (a.membrane == "skalak") summary_fields["skalak_c"] = a.skalak_c;

@@ -16,6 +16,11 @@ const MembraneParameters& checked(const MembraneParameters& p) {
   if (!(p.kB >= 0) || !std::isfinite(p.kB))
     throw Error(fmt::format("membrane: kB must be non-negative, got {}", p.kB));
   if (p.kB > 0 && p.bending == nullptr) throw Error("membrane: kB > 0 needs a bending method");
+  if (!p.bending_terms.plain()) {
+    if (!(p.kB > 0) || p.bending == nullptr)
+      throw Error("membrane: c0 and ADE need a bending method and kB > 0");
+    p.bending->check_parameters(p.bending_parameters());
+  }
   return p;
 }
 }  // namespace
@@ -36,7 +41,10 @@ void MembraneModel::forces(const Points& x, Points& force) const {
   require_finite_rows(force, "membrane: the " + parameters_.elastic_law + " elastic force");
   if (parameters_.bending != nullptr && parameters_.kB > 0) {
     Points bending;
-    parameters_.bending->forces(*topology_, x, parameters_.kB, bending);
+    if (parameters_.bending_terms.plain())
+      parameters_.bending->forces(*topology_, x, parameters_.kB, bending);
+    else
+      parameters_.bending->forces(*topology_, x, parameters_.bending_parameters(), bending);
     require_finite_rows(bending, "membrane: the bending force of method " + parameters_.bending->name());
     force += bending;
   }
@@ -66,7 +74,8 @@ double MembraneModel::elastic_energy(const Points& x) const { return elastic_->e
 
 std::optional<double> MembraneModel::bending_energy(const Points& x) const {
   if (parameters_.bending == nullptr) return std::nullopt;
-  return parameters_.bending->energy(*topology_, x, parameters_.kB);
+  if (parameters_.bending_terms.plain()) return parameters_.bending->energy(*topology_, x, parameters_.kB);
+  return parameters_.bending->energy(*topology_, x, parameters_.bending_parameters());
 }
 
 std::optional<double> MembraneModel::volume_energy(const Points& x) const {

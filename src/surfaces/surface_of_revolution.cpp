@@ -210,6 +210,42 @@ SurfaceValues SurfaceOfRevolution::at_angles(double t, double phi, double kappa_
   return from_meridian(meridian(t), std::cos(phi), std::sin(phi), kappa_b);
 }
 
+SurfaceOfRevolution::Integrals SurfaceOfRevolution::integrals() const {
+  // Gauss-Legendre nodes on [0, pi] by Newton on P_n; the integrands 2 pi r s' and 2 pi H r s'
+  // are analytic in t.
+  constexpr int n = 400;
+  Integrals out;
+  for (int i = 0; i < n; ++i) {
+    double x = std::cos(kPi * (i + 0.75) / (n + 0.5)), dp = 1;
+    for (int it = 0; it < 100; ++it) {
+      double p0 = 1, p1 = x;
+      for (int k = 2; k <= n; ++k) {
+        const double p2 = ((2 * k - 1) * x * p1 - (k - 1) * p0) / k;
+        p0 = p1, p1 = p2;
+      }
+      dp = n * (x * p1 - p0) / (x * x - 1);
+      const double dx = p1 / dp;
+      x -= dx;
+      if (std::abs(dx) < 1e-16) break;
+    }
+    const double w = kPi / ((1 - x * x) * dp * dp);
+    const MeridianValues m = meridian(0.5 * kPi * (1 + x));
+    const double da = 2 * kPi * m.r * m.ds_dt * w;
+    out.area += da;
+    out.mean_curvature += m.H * da;
+  }
+  return out;
+}
+
+double SurfaceOfRevolution::max_force_density(double c0, double kappa_b, double lambda) const {
+  return curve_max([&](double t) {
+    const MeridianValues m = meridian(t);
+    // docs/conventions.md §5 (bending_parameters.hpp's membrane_normal_force; surfaces do not
+    // depend on the bending module).
+    return std::abs(2.0 * kappa_b * (m.lapH + 2.0 * (m.H - c0) * (m.H * m.H + c0 * m.H - m.K)) - lambda * m.K);
+  });
+}
+
 SurfaceMaxima SurfaceOfRevolution::maxima(double kappa_b) const {
   std::call_once(maxima_once_, [this] {
     SurfaceMaxima& mx = maxima_unit_kb_;

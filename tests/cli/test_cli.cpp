@@ -339,6 +339,25 @@ TEST_F(Cli, ShearTakesMethodOptionsAsPartOfTheRunsIdentity) {
   EXPECT_EQ(r.status, 0) << r.err;
 }
 
+TEST_F(Cli, SpontaneousCurvatureAndAdeAreRefusedWhereInvalid) {
+  const fs::path out = dir / "run", study = dir / "study", mesh = dir / "s.off";
+  ASSERT_EQ(run("mesh --level 1 --out " + mesh.string()).status, 0);
+  const std::string forces = "forces --mesh " + mesh.string() + " --out " + (dir / "f.csv").string();
+  expect_refused(run(forces + " --method C --c0 nan"), "c0 must be finite", dir / "f.csv");
+  expect_refused(run(forces + " --method C --c0 inf"), "c0 must be finite", dir / "f.csv");
+  expect_refused(run(forces + " --method C --ade-alpha 1 --ade-d 0.1"), "--ade-area", dir / "f.csv");
+  expect_refused(run(forces + " --method C --ade-alpha -1 --ade-d 0.1 --ade-area 1"), "alpha", dir / "f.csv");
+  expect_refused(run(forces + " --method C --ade-alpha 1 --ade-d -0.1 --ade-area 1"), "leaflet distance",
+                 dir / "f.csv");
+  expect_refused(run(forces + " --method C --ade-d 0.1"), "--ade-alpha", dir / "f.csv");
+  expect_refused(run(forces + " --method A --c0 1"), "method A", dir / "f.csv");
+  expect_refused(run("rbc --methods A --c0 1 --max-triangles 320 --families mt1 --no-plots --out " + study.string()),
+                 "method A", study);
+  expect_refused(run("shear --method C --kappa-b-hat 0.1 --c0 nan --out " + out.string()), "c0", out);
+  expect_refused(run("shear --c0 1 --out " + out.string()), "--method", out);
+  expect_refused(run("shear --method A --kappa-b-hat 0.1 --c0 1 --out " + out.string()), "method A", out);
+}
+
 TEST_F(Cli, ShearWritesItsFilesAndResumes) {
   const fs::path out = dir / "run";
   CliRun r = run("shear --mesh mt1:320 --G 0.1 --t-end 0.3 --snapshot-every 0.1 --no-plot --out " + out.string());

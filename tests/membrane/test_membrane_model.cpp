@@ -96,6 +96,35 @@ TEST(MembraneModel, EnergyBasedBendingAndVolumeHook) {
   EXPECT_DOUBLE_EQ(*with_volume.volume_energy(x), 1.5 * dv * dv);
 }
 
+TEST(MembraneModel, SpontaneousCurvatureAndAdeReachTheBendingMethod) {
+  // docs/conventions.md §5: the model hands the method kB with c0 and ADE; A refuses them.
+  const TriMesh m = sphere_mesh(MeshFamily::MT1, 1);
+  const Points x = deformed(m);
+  MembraneParameters p;
+  p.kS = 2;
+  p.kB = 0.1;
+  p.bending = make_bending_method("J");
+  const MembraneModel plain(m, p);
+  p.bending_terms.c0 = 0.8;
+  p.bending_terms.ade_alpha = 2;
+  p.bending_terms.ade_d = 0.05;
+  p.bending_terms.ade_area = 12;
+  const MembraneModel with_terms(m, p);
+  Points f0, f1, b0, b1;
+  plain.forces(x, f0);
+  with_terms.forces(x, f1);
+  p.bending->forces(m.topology(), x, 0.1, b0);
+  p.bending->forces(m.topology(), x, p.bending_parameters(), b1);
+  EXPECT_GT((b1 - b0).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_LT((f1 - f0 - (b1 - b0)).cwiseAbs().maxCoeff(), 1e-12 * f1.cwiseAbs().maxCoeff());
+  EXPECT_EQ(*with_terms.bending_energy(x), *p.bending->energy(m.topology(), x, p.bending_parameters()));
+  p.bending = make_bending_method("A");
+  EXPECT_THROW(MembraneModel(m, p), Error);
+  p.bending = make_bending_method("C");
+  p.kB = 0;
+  EXPECT_THROW(MembraneModel(m, p), Error);  // c0 without bending
+}
+
 TEST(MembraneModel, ConcurrentCallsAgree) {
   // Const methods allocate their scratch per call: two threads on one model get the serial result.
   const TriMesh m = sphere_mesh(MeshFamily::MT1, 2);

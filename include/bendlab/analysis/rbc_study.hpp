@@ -47,6 +47,10 @@ struct RbcStudyOptions {
   double jitter = kDefaultJitterFraction;
   std::uint64_t jitter_seed = kDefaultJitterSeed;
   double kappa_b = 1.0;
+  /// Spontaneous curvature and ADE (docs/conventions.md §5): the exact force density of the RBC is
+  /// then the general force law from its exact H, K, Lap H, with M and the ADE area A those of the
+  /// exact shape. All zero: the paper's study, unchanged.
+  double c0 = 0.0, ade_alpha = 0.0, ade_d = 0.0, ade_da0 = 0.0;
   double radius = 1.0;
   /// Per-node data (numerical results, errors) are kept for meshes with N_T <= this, and for the
   /// inhomogeneous meshes; larger meshes keep only the summaries.
@@ -61,6 +65,8 @@ const std::vector<std::string>& rbc_study_families();
 /// non-positive kappa_b or radius, method options that a method refuses, or a jitter that folds a
 /// triangle of an irregular mesh of the study (the irregular meshes are generated to check that).
 void validate(const RbcStudyOptions& options);
+/// The membrane parameters of a study: kB, c0 and ADE with A = the exact area of the RBC.
+BendingParameters rbc_bending_parameters(const RbcStudyOptions& options);
 
 struct MethodRun {
   std::string method;

@@ -198,6 +198,11 @@ class BelkinMethod final : public BendingMethod {
   std::string name() const override { return "D"; }
   BendingResult compute(const Topology& topology, const Points& x, double kappa_b) const override;
 
+ protected:
+  /// c0 and ADE through the force law of docs/conventions.md §5 (variational_assembly.hpp).
+  bool supports_membrane_terms() const override { return true; }
+  BendingResult compute_terms(const Topology& topology, const Points& x, const BendingParameters& params) const override;
+
  private:
   BelkinOptions options_;
 };

@@ -11,6 +11,7 @@
 #include <optional>
 #include <string>
 
+#include "bendlab/bending/bending_parameters.hpp"
 #include "bendlab/core/types.hpp"
 #include "bendlab/mesh/topology.hpp"
 
@@ -43,6 +44,36 @@ class BendingMethod {
   }
   /// E_B for energy-based methods, std::nullopt otherwise.
   virtual std::optional<double> energy(const Topology&, const Points&, double) const { return std::nullopt; }
+
+  // With spontaneous curvature and ADE (bending_parameters.hpp, docs/conventions.md §5). For
+  // plain parameters (c0 = 0, no ADE) these call the functions above, so the results are those
+  // of the paper's methods bit for bit; otherwise they validate the parameters and call the
+  // *_terms hooks, which refuse (bendlab::Error naming the method) unless the method overrides them.
+
+  /// Every per-vertex quantity with the energy of `p`.
+  BendingResult compute(const Topology& topology, const Points& x, const BendingParameters& p) const;
+  /// Node forces only.
+  void forces(const Topology& topology, const Points& x, const BendingParameters& p, Points& force) const;
+  /// E = 2 kB ∫ (H - c0)^2 dA + E_ADE for energy-based methods, std::nullopt otherwise.
+  std::optional<double> energy(const Topology& topology, const Points& x, const BendingParameters& p) const;
+  /// Throws bendlab::Error (one line, naming the method) if the method cannot take `p`: invalid
+  /// parameters, or c0 / ADE for a method without them. Cheap: call it before a long run.
+  void check_parameters(const BendingParameters& p) const;
+
+ protected:
+  /// Whether the method implements c0 and ADE (the *_terms hooks below).
+  virtual bool supports_membrane_terms() const { return false; }
+  /// Why not, for the error message (docs/conventions.md §5).
+  virtual std::string membrane_terms_refusal() const;
+  virtual BendingResult compute_terms(const Topology& topology, const Points& x, const BendingParameters& p) const;
+  /// Default: compute_terms(...).force.
+  virtual void forces_terms(const Topology& topology, const Points& x, const BendingParameters& p,
+                            Points& force) const {
+    force = compute_terms(topology, x, p).force;
+  }
+  virtual std::optional<double> energy_terms(const Topology&, const Points&, const BendingParameters&) const {
+    return std::nullopt;
+  }
 };
 
 /// Creates a method by name ("A".."E", "ED", or any method registered since), with its options,

@@ -33,6 +33,17 @@ class GompperKroll : public BendingMethod {
   BendingResult compute(const Topology& topology, const Points& x, double kappa_b) const override;
   void forces(const Topology& topology, const Points& x, double kappa_b, Points& force) const override;
   std::optional<double> energy(const Topology& topology, const Points& x, double kappa_b) const override;
+
+ protected:
+  /// c0 and ADE (docs/conventions.md §5): E = 2 kB sum_i (H_i - c0)^2 A_i + E_ADE with the signed
+  /// H_i = sign(S_i . N_i) |S_i| / (4 A_i) (N_i the area-weighted normal), M = sum_i H_i A_i, and
+  /// its exact gradient (gompper_kroll.cpp). H in the result has that sign.
+  bool supports_membrane_terms() const override { return true; }
+  BendingResult compute_terms(const Topology& topology, const Points& x, const BendingParameters& p) const override;
+  void forces_terms(const Topology& topology, const Points& x, const BendingParameters& p,
+                    Points& force) const override;
+  std::optional<double> energy_terms(const Topology& topology, const Points& x,
+                                     const BendingParameters& p) const override;
 };
 
 }  // namespace bendlab

@@ -39,6 +39,16 @@ class JulicherMethod : public BendingMethod {
   BendingResult compute(const Topology& topology, const Points& x, double kappa_b) const override;
   void forces(const Topology& topology, const Points& x, double kappa_b, Points& force) const override;
   std::optional<double> energy(const Topology& topology, const Points& x, double kappa_b) const override;
+
+ protected:
+  /// c0 and ADE (docs/conventions.md §5): E = 2 kB sum_i (H_i - c0)^2 A_i + E_ADE with the discrete
+  /// M = sum_i H_i A_i = 1/2 sum_e l_e theta_e, and its exact gradient.
+  bool supports_membrane_terms() const override { return true; }
+  BendingResult compute_terms(const Topology& topology, const Points& x, const BendingParameters& p) const override;
+  void forces_terms(const Topology& topology, const Points& x, const BendingParameters& p,
+                    Points& force) const override;
+  std::optional<double> energy_terms(const Topology& topology, const Points& x,
+                                     const BendingParameters& p) const override;
 };
 
 }  // namespace bendlab

@@ -41,6 +41,12 @@ class KantorNelson : public BendingMethod {
  private:
   /// Fills force (resized to N x 3) and returns the energy.
   double energy_and_forces(const Topology& topology, const Points& x, double kappa_b, Points& force) const;
+
+ protected:
+  /// A is refused c0 and ADE (docs/conventions.md §5): see membrane_terms_refusal().
+  std::string membrane_terms_refusal() const override;
+
+ private:
   bool small_angle_;
 };
 

@@ -42,6 +42,7 @@
 #include <Eigen/Sparse>
 
 #include "bendlab/bending/bending_method.hpp"
+#include "bendlab/bending/loop_shell_energy.hpp"
 #include "bendlab/bending/method_registry.hpp"
 
 namespace bendlab {
@@ -76,12 +77,25 @@ class LoopShellMethod final : public BendingMethod {
   void forces(const Topology& topology, const Points& x, double kappa_b, Points& force) const override;
   std::optional<double> energy(const Topology& topology, const Points& x, double kappa_b) const override;
 
+ protected:
+  /// c0 and ADE on the limit surface (docs/conventions.md §5): E = 2 kB int (H - c0)^2 dA + E_ADE with
+  /// M = int H dA, exact gradient on the control points (loop_shell_energy.hpp), f from the weak form.
+  bool supports_membrane_terms() const override { return true; }
+  BendingResult compute_terms(const Topology& topology, const Points& x, const BendingParameters& p) const override;
+  void forces_terms(const Topology& topology, const Points& x, const BendingParameters& p,
+                    Points& force) const override;
+  std::optional<double> energy_terms(const Topology& topology, const Points& x,
+                                     const BendingParameters& p) const override;
+
+ public:
+
   /// Control points for nodes x (step 1).
   Points control_points(const Topology& topology, const Points& x) const;
-  /// Steps 1-3.
-  LoopShellState state(const Topology& topology, const Points& x, double kappa_b) const;
-  /// E_B of the limit surface of given control points, and dE_B/dP if gradient is not null.
-  double control_energy(const Topology& topology, const Points& control, double kappa_b,
+  /// Steps 1-3 (with c0 and ADE where `p` has them, docs/conventions.md §5).
+  LoopShellState state(const Topology& topology, const Points& x, const BendingParameters& p) const;
+  /// E_B of the limit surface of given control points, and dE_B/dP if gradient is not null; with
+  /// c0 and ADE, E = 2 kB int (H - c0)^2 dA + E_ADE(int H dA) on the limit surface.
+  double control_energy(const Topology& topology, const Points& control, const BendingParameters& p,
                         Points* gradient = nullptr) const;
 
   Control control() const { return control_; }
@@ -92,7 +106,11 @@ class LoopShellMethod final : public BendingMethod {
  private:
   struct Cache;
   std::shared_ptr<Cache> cache_for(const Topology& topology) const;
-  BendingResult evaluate(const Topology& topology, const Points& x, double kappa_b, bool nodal_geometry) const;
+  BendingResult evaluate(const Topology& topology, const Points& x, const BendingParameters& p,
+                         bool nodal_geometry) const;
+  /// The energy's coefficients for `p` at control points P (M = int H dA of the limit surface for ADE).
+  loop_shell::ShellTerms shell_terms(Cache& cache, const Points& control, const BendingParameters& p,
+                                     double* ade_energy) const;
   /// M X = B with the chosen solver.
   Eigen::MatrixXd solve_mass(Cache& cache, const Eigen::SparseMatrix<double>& m, const Eigen::MatrixXd& b) const;
 

@@ -46,7 +46,7 @@ constexpr int kParallelFaces = 4096;
 /// mass.pattern()'s pattern) M for P, and into h_rhs (if not null) int N_I H dA. OpenMP threads
 /// from `parallel_faces` faces on.
 double shell_energy_mass(const LoopPatches& patches, const QuadratureBases& bases, const MassPattern& mass,
-                         const FaceColouring& colouring, const Points& control, double kappa_b, Points& gradient,
+                         const FaceColouring& colouring, const Points& control, const ShellTerms& terms, Points& gradient,
                          Eigen::SparseMatrix<double>& m, Eigen::VectorXd* h_rhs = nullptr,
                          int parallel_faces = kParallelFaces);
 

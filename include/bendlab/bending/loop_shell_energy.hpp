@@ -19,6 +19,21 @@
 
 namespace bendlab::loop_shell {
 
+/// The energy's coefficients: kB, and for c0 and ADE (docs/conventions.md §5) the spontaneous
+/// curvature and lambda = alpha pi kB (M - M0) / A (BendingParameters::ade_lambda) at the current
+/// shape, held fixed over one evaluation: E = 2 kB int (H - c0)^2 dA (+ E_ADE, added by the caller)
+/// and
+///   dE/dP_I = sum_T sum_q w_q [(4 kB (H - c0) + lambda) J dH/dP_I + (2 kB (H - c0)^2 + lambda H) dJ/dP_I].
+/// A plain kB (implicit conversion) takes the c0 = 0 expressions of the header unchanged.
+struct ShellTerms {
+  double kappa_b = 1.0;
+  double c0 = 0.0;
+  double lambda = 0.0;
+  bool plain = true;
+  ShellTerms(double kappa_b) : kappa_b(kappa_b) {}  // NOLINT(google-explicit-constructor)
+  ShellTerms(double kappa_b, double c0, double lambda) : kappa_b(kappa_b), c0(c0), lambda(lambda), plain(false) {}
+};
+
 /// The basis of every patch valence at every point of a quadrature rule (patch-local (v, w)).
 /// The rules are symmetric, so the same points serve whichever corner a patch starts at.
 class QuadratureBases {
@@ -57,7 +72,7 @@ struct FaceLocal {
   Eigen::VectorXd h;
 };
 double face_energy(const std::vector<PatchBasis>& basis, const TriangleRule& rule, const Points& control,
-                   const int* idx, double kappa_b, FaceLocal* local);
+                   const int* idx, const ShellTerms& terms, FaceLocal* local);
 
 /// What face_energy_fast returns for one patch of m = N + 6 control points: its rows of dE_B/dP
 /// (patch order), its mass block int N_a N_b dA as the upper triangle (pairs a <= b, row by row)
@@ -76,14 +91,17 @@ struct FaceWork {
 /// block from QuadratureBases::mass_products, no heap allocation. Returns false (and does
 /// nothing) for another valence. Adds the patch's E_B to `energy`; h only if with_h.
 bool face_energy_fast(const QuadratureBases& bases, int valence, const Points& control, const int* idx,
-                      double kappa_b, bool with_h, FaceWork& work, double& energy);
+                      const ShellTerms& terms, bool with_h, FaceWork& work, double& energy);
 
 /// E_B = 2 kB int H^2 dA over the limit surface with the rule of `bases`; if gradient is not
 /// null it is resized to P's shape and receives dE_B/dP (so F = -gradient).
 double shell_energy(const LoopPatches& patches, const QuadratureBases& bases, const Points& control,
-                    double kappa_b, Points* gradient);
+                    const ShellTerms& terms, Points* gradient);
 
 /// Surface area of the limit surface, int dA, with the same rule.
 double shell_area(const LoopPatches& patches, const QuadratureBases& bases, const Points& control);
+
+/// M = int H dA over the limit surface with the same rule (the ADE term, docs/conventions.md §5).
+double shell_mean_curvature_integral(const LoopPatches& patches, const QuadratureBases& bases, const Points& control);
 
 }  // namespace bendlab::loop_shell

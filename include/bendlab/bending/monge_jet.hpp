@@ -131,6 +131,13 @@ class MongeJetMethod : public BendingMethod {
 
   std::string name() const override { return "M"; }
   BendingResult compute(const Topology& topology, const Points& x, double kappa_b) const override;
+
+ protected:
+  /// c0 and ADE through the force law of docs/conventions.md §5 (variational_assembly.hpp).
+  bool supports_membrane_terms() const override { return true; }
+  BendingResult compute_terms(const Topology& topology, const Points& x, const BendingParameters& params) const override;
+
+ public:
   const MongeJetSettings& settings() const { return settings_; }
 
  private:

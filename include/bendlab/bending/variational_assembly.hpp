@@ -10,7 +10,10 @@ namespace bendlab {
 /// Assembles the result of a variational method (C, D, E, ...) from its per-vertex normal, H, K
 /// and lapH: f by eq. (10) with the docs/conventions.md sign, F = f * area by eq. (14). `area` is the
 /// mixed area. Moves the inputs into the result; energy stays empty.
+/// With c0 or ADE (bending_parameters.hpp, docs/conventions.md §5) f is the general force law
+///   f = {2 kB [Lap H + 2 (H - c0)(H^2 + c0 H - K)] - lambda K} n,  lambda = alpha pi kB (M - M0) / A,
+/// with the discrete M = sum_i H_i A_mixed_i; plain parameters take eq. (10)'s loop unchanged.
 BendingResult assemble_variational_result(Points normal, Scalars H, Scalars K, Scalars lapH, Scalars area,
-                                          double kappa_b);
+                                          const BendingParameters& p);
 
 }  // namespace bendlab

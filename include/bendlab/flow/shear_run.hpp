@@ -44,6 +44,10 @@ struct ShearRunSpec {
   double G = 0.1;                      ///< mu gamma R / kS
   std::optional<double> kappa_b_hat;   ///< kB / (R^2 kS) (exclusive with kappa_b)
   std::optional<double> kappa_b;       ///< dimensional kB
+  /// Spontaneous curvature and ADE (docs/conventions.md §5) in units of R (R = 1 in these runs):
+  /// c0 R, alpha, d / R, dA0 / R^2, A / R^2. ade_area: none = the area of the initial mesh.
+  double c0 = 0, ade_alpha = 0, ade_d = 0, ade_da0 = 0;
+  std::optional<double> ade_area;
   double t_end = 10;                   ///< gamma t
   double snapshot_every = 0.5;         ///< gamma t between snapshots and checkpoints
   std::string integrator = "cash-karp";  ///< BIM time stepping: "cash-karp" or "rkc" (stiff-stable, integrate/rkc.hpp)

@@ -32,6 +32,15 @@ struct MembraneParameters {
   double skalak_c = kDefaultSkalakC;        ///< the Skalak law's C (> -1/2; elasticity/skalak.hpp)
   std::shared_ptr<const BendingMethod> bending;  ///< nullptr: no bending forces
   std::shared_ptr<const VolumeForce> volume_force;  ///< nullptr: none
+  /// Spontaneous curvature and ADE of the bending energy (docs/conventions.md §5); its kappa_b is
+  /// not used (kB above is). Plain (the default): the paper's bending force.
+  BendingParameters bending_terms;
+  /// The bending parameters the method receives: bending_terms with kappa_b = kB.
+  BendingParameters bending_parameters() const {
+    BendingParameters p = bending_terms;
+    p.kappa_b = kB;
+    return p;
+  }
 };
 
 /// The nodal forces of one shape and what they are made of.

@@ -67,6 +67,15 @@ class SurfaceOfRevolution : public AnalyticSurface {
   double radial_scale() const { return A_; }
   /// Z(w).
   double height_factor(double w) const;
+  /// Area int dA and integrated mean curvature M = int H dA (Gauss-Legendre in t, converged to
+  /// rounding for the shapes here).
+  struct Integrals {
+    double area = 0, mean_curvature = 0;
+  };
+  Integrals integrals() const;
+  /// max over the surface of |f_n| of the force law with spontaneous curvature c0 and ADE
+  /// coefficient lambda (bending/bending_parameters.hpp, docs/conventions.md §5).
+  double max_force_density(double c0, double kappa_b, double lambda) const;
 
  private:
   SurfaceValues from_meridian(const MeridianValues& m, double cos_phi, double sin_phi,
