@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
@@ -217,10 +218,27 @@ std::span<const Vec3> gather(const Points& x, const std::vector<int>& v, std::ve
   return buffer;
 }
 
+/// Step 2's trim: the `count` points nearest to x0 and every point as near as the last of them
+/// (to 1e-9 relative); count 0 or a smaller support: unchanged.
+void trim_support(const Vec3& x0, int count, std::vector<Vec3>& support) {
+  if (count <= 0 || static_cast<int>(support.size()) <= count) return;
+  auto closer = [&](const Vec3& p, const Vec3& q) { return (p - x0).squaredNorm() < (q - x0).squaredNorm(); };
+  std::nth_element(support.begin(), support.begin() + (count - 1), support.end(), closer);
+  const double cut = (support[count - 1] - x0).squaredNorm() * (1 + 1e-9);
+  support.erase(std::partition(support.begin(), support.end(),
+                               [&](const Vec3& p) { return (p - x0).squaredNorm() <= cut; }),
+                support.end());
+}
+
 void check_settings(const MongeJetSettings& s) {
   if (s.degree < 4 || s.degree > 6)
     throw Error(fmt::format("method M: degree must be 4, 5 or 6, got {}", s.degree));
   if (s.rings < 2 || s.rings > 3) throw Error(fmt::format("method M: support_rings must be 2 or 3, got {}", s.rings));
+  if (s.support_points != 0 && s.support_points < monge_jet_min_points(s.degree))
+    throw Error(fmt::format("method M: support_points must be 0 (keep the rings whole) or at least {} (the {} "
+                            "unknowns of a degree-{} jet + 4), got {}",
+                            monge_jet_min_points(s.degree), monge_jet_unknowns(s.degree), s.degree,
+                            s.support_points));
 }
 
 }  // namespace
@@ -336,6 +354,7 @@ std::vector<MongeJetFit> monge_jet_fit(const Topology& t, const Points& x, const
         const Vec3 n0 = settings.frame == MongeFrame::AngleWeighted
                             ? mwa
                             : covariance_normal(x0, std::span<const Vec3>(support).first(lists.two_ring[i]), mwa);
+        trim_support(x0, settings.support_points, support);
         nodes[l] = MongeJetNode{x0, n0, support};
       }
       fit_lanes(std::span<const MongeJetNode>(nodes.data(), count), settings.degree, settings.gaussian_weights,
@@ -394,6 +413,7 @@ std::unique_ptr<BendingMethod> MongeJetMethod::create(const MethodOptions& optio
   s.rings = static_cast<int>(option_int(options, "support_rings"));
   s.frame = options.at("frame") == "angle-weighted" ? MongeFrame::AngleWeighted : MongeFrame::Covariance;
   s.gaussian_weights = option_bool(options, "gaussian_weights");
+  s.support_points = static_cast<int>(option_int(options, "support_points"));
   return std::make_unique<MongeJetMethod>(s);
 }
 
@@ -404,6 +424,9 @@ MethodInfo MongeJetMethod::info() {
                 int_option("support_rings", 2, 3, 3,
                            "fitting support in rings of neighbours (widened while it has fewer than "
                            "unknowns + 4 points or the fit is singular)"),
+                int_option("support_points", 0, 1000, 40,
+                           "keep the nearest this many points of the rings, and any as near as the last "
+                           "(0: all; else at least unknowns + 4)"),
                 choice_option("frame", {"covariance", "angle-weighted"}, "covariance",
                               "chart normal: smallest principal axis of the 2-ring, or the angle-weighted normal"),
                 bool_option("gaussian_weights", false,

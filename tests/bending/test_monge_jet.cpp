@@ -413,6 +413,30 @@ TEST(MongeJet, KeptSupportsFollowTheConnectivity) {
   EXPECT_THROW(monge_jet_fit(c.topology(), c.positions(), g.normal_mwa, settings, supports), Error);
 }
 
+TEST(MongeJet, SupportTrimKeepsRegularThreeRingsWhole) {
+  // The trim to the 40 nearest points (and those as near) leaves a valence-6 vertex's 3-ring of
+  // 36 points whole, so away from the 12 valence-5 vertices and their neighbourhoods M's H equals
+  // the untrimmed method's to the last bit; the valence-5 vertices, whose supports were widened to
+  // 4 rings, are trimmed and change. Counts below unknowns + 4 are refused.
+  const TriMesh sphere = sphere_mesh(MeshFamily::MT1, 4);  // 5120 triangles
+  const TriMesh m = sphere.with_positions(make_rbc()->map_from_unit_sphere(sphere.positions()));
+  const BendingResult trimmed = make_bending_method("M")->compute(m.topology(), m.positions(), 1.0);
+  const BendingResult whole =
+      make_bending_method("M", {{"support_points", "0"}})->compute(m.topology(), m.positions(), 1.0);
+  int same = 0, changed_irregular = 0;
+  for (int i = 0; i < m.num_vertices(); ++i) {
+    if (m.topology().valence(i) == 6) same += trimmed.H[i] == whole.H[i];
+    else changed_irregular += trimmed.H[i] != whole.H[i];
+  }
+  int valence6 = 0;
+  for (int i = 0; i < m.num_vertices(); ++i) valence6 += m.topology().valence(i) == 6;
+  EXPECT_EQ(same, valence6);
+  EXPECT_EQ(changed_irregular, 12);
+  EXPECT_THROW(make_bending_method("M", {{"support_points", "30"}}), Error);
+  EXPECT_THROW(make_bending_method("M", {{"support_points", "23"}, {"degree", "5"}}), Error);
+  EXPECT_NO_THROW(make_bending_method("M", {{"support_points", "24"}, {"degree", "5"}}));
+}
+
 TEST(MongeJet, SphereMeshesConvergeToTheSphere) {
   // On the unit sphere H = 1, K = 1, Lap H = 0 and f = 0: the errors fall under refinement.
   std::array<double, 4> previous{INFINITY, INFINITY, INFINITY, INFINITY};

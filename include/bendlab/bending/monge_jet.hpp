@@ -12,7 +12,15 @@
 //    the 2-ring of i, signed to agree with the angle-weighted (MWA) normal; option frame =
 //    angle-weighted takes the MWA normal itself. t1, t2 complete a right-handed frame.
 // 2. Support: the vertices within `rings` edge-rings (i excluded; option support_rings), widened ring by ring while it has
-//    fewer than monge_jet_min_points(degree) points (24 for degree 5) or while the fit is singular.
+//    fewer than monge_jet_min_points(degree) points (24 for degree 5) or while the fit is singular;
+//    then trimmed to the support_points (default 40) nearest to x_i, with every point as near as the
+//    last one kept (no arbitrary choice among equidistant points). Rings count edges, not
+//    distance: where the mesh is graded (Rivara refinement) or a vertex has valence 8-10, the
+//    3-ring holds 50 and more points and reaches farther on the coarse side, and the jet's
+//    truncation error grows with the support's radius; the trim gives every node about the radius
+//    of a regular 3-ring. On the Rivara meshes of table 3 it took r_max of f from 2.6 (MT2) and
+//    2.4 (MT1) to about 1.1-1.2; r_max stays below 1.6 for any count from 37 to 44, and 33 is too
+//    few (docs/results/rbc.md, table 3).
 // 3. Fit: w = sum_{1 <= a+b <= degree} c_ab (u/s)^a (v/s)^b, s the RMS of |(u, v)| over the support;
 //    unweighted least squares (option gaussian_weights: weights exp(-|(u,v)|^2 / (2 s^2))); no
 //    constant term, the surface passes through x_i.
@@ -51,6 +59,10 @@ struct MongeJetSettings {
   int rings = 3;                           ///< 2 or 3: the support before any widening
   MongeFrame frame = MongeFrame::Covariance;
   bool gaussian_weights = false;
+  /// Step 2's trim: of the rings' points, the nearest this many and every point as near as the
+  /// last of them are kept (0: all). 40 is a little more than a regular vertex's 3-ring (36), so
+  /// on regular meshes only the few widened supports are trimmed; see the header comment.
+  int support_points = 40;
 };
 
 /// Unknowns of a jet of this degree without constant term: (degree + 1)(degree + 2)/2 - 1.
