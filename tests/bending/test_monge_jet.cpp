@@ -418,7 +418,7 @@ TEST(MongeJet, SupportTrimKeepsRegularThreeRingsWhole) {
   // 36 points whole, so away from the 12 valence-5 vertices and their neighbourhoods M's H equals
   // the untrimmed method's to the last bit; the valence-5 vertices, whose supports were widened to
   // 4 rings, are trimmed and change. Counts below unknowns + 4 are refused.
-  const TriMesh sphere = sphere_mesh(MeshFamily::MT1, 4);  // 5120 triangles
+  const TriMesh sphere = sphere_mesh(MeshFamily::MT1, 3);  // 1280 triangles
   const TriMesh m = sphere.with_positions(make_rbc()->map_from_unit_sphere(sphere.positions()));
   const BendingResult trimmed = make_bending_method("M")->compute(m.topology(), m.positions(), 1.0);
   const BendingResult whole =
