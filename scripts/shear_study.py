@@ -104,9 +104,15 @@ E_QUADRATURE = "all7"
 RTOL, ATOL = "1e-7", "1e-6"
 # A run fails once it takes more accepted steps than this: 4 times the most any run of the paper's
 # cases needs (24402, C at 5120 triangles by Cash-Karp); a shape that goes unstable makes its step
-# collapse to 1e-10 and would crawl on for days. Such a failure is recorded in the run's folder
-# (failed.json) and reported, not retried: delete the folder to run it again.
+# collapse to 1e-10 and would crawl on for days. Such a failure, like any other failure during the
+# steps (a singular fit, a non-finite force: deterministic, so a rerun repeats it), is recorded in
+# the run's folder (failed.json) and reported, not retried: delete the folder to run it again.
 MAX_STEPS = 100_000
+
+
+def failed_while_stepping(error):
+    """Whether `error` is a failure of the run's own steps (not of its start, files or resume)."""
+    return "the run failed after step" in (error or "")
 FIG16_METHODS = ["C", "S"]  # figure 16: G = 0.05, kB_hat = 0.0375 (runs of figure 14)
 FIG17_KB = 2.0 / 15.0  # figure 17: Methods A and C at kB_hat = 2/15, G = 0.05 and 0.2
 FIG17_G = [0.05, 0.2]
@@ -303,7 +309,7 @@ def _failure_identity(run):
 
 
 def write_failure(out, run, error):
-    """failed.json: a run that spent its step budget, so that the next study does not run it again."""
+    """failed.json: a run that failed while stepping, so that the next study does not run it again."""
     record = dict(_failure_identity(run), error=error)
     tmp = out / "failed.json.tmp"
     tmp.write_text(json.dumps(record, indent=1) + "\n")
@@ -346,7 +352,7 @@ def execute(run, work, bendlab, counter, total):
     say(f"[  /{total}] {'resume ' if resume else 'start  '}  {run.label()}")
     start = time.monotonic()
     rc, err = _launch(run, out, bendlab, resume)
-    if rc != 0 and resume and "--max-steps" not in err:
+    if rc != 0 and resume and not failed_while_stepping(err):
         say(f"[  /{total}] resume failed, starting over: {run.label()}")
         shutil.rmtree(out)
         out.mkdir(parents=True)
@@ -356,7 +362,7 @@ def execute(run, work, bendlab, counter, total):
     n = counter.next()
     if rc != 0 or summary is None:
         say(f"[{n:2d}/{total}] FAILED   {run.label()} (exit {rc}, {elapsed:.0f} s): {err}")
-        if "--max-steps" in err:
+        if failed_while_stepping(err):
             write_failure(out, run, err)
         return Result(run, None, error=err or f"exit status {rc}")
     say(f"[{n:2d}/{total}] done     {run.label()}: D_steady {summary['D_steady']:.4f}, "
@@ -1312,8 +1318,8 @@ def main():
     if failed:
         lines += ["### Failed runs", "",
                   "Runs that ended with an error (their last checkpoint kept in the work folder; a run that "
-                  f"spent the budget of {MAX_STEPS} accepted steps is not run again until its folder is "
-                  "deleted):", ""]
+                  f"failed while stepping, or spent the budget of {MAX_STEPS} accepted steps, is not run again "
+                  "until its folder is deleted):", ""]
         lines += [f"- {r.run.label()}: {failure_reason(r.error)}" for r in sorted(failed, key=lambda r: r.run.label())]
         lines.append("")
     text = "\n".join(lines)

@@ -50,3 +50,11 @@ def test_the_document_shows_the_reason_without_the_prefix_and_path():
     assert "/x/y" not in reason and "bendlab: error" not in reason
     assert shear_study.failure_reason("exit status 3") == "exit status 3"
     assert shear_study.failure_reason(None) == ""
+
+
+def test_only_failures_of_the_steps_are_recorded():
+    assert shear_study.failed_while_stepping(
+        "bendlab: error: the run failed after step 51807 (gamma t = 4.23): method M: the jet at vertex 101 is singular")
+    assert not shear_study.failed_while_stepping("bendlab: error: --resume: no checkpoint in 'x' to resume from")
+    assert not shear_study.failed_while_stepping("exit status -9")
+    assert not shear_study.failed_while_stepping(None)
