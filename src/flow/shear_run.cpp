@@ -104,13 +104,15 @@ CapsuleRunResult run_shear(const ShearRunSpec& a, const ShearRunCallbacks& callb
   if (a.resume && a.overwrite) throw Error("--resume and --overwrite exclude each other");
   if (a.resume && !fs::exists(a.folder / "checkpoint.json"))
     throw Error(fmt::format("--resume: no checkpoint in '{}' to resume from", a.folder.string()));
+  check_capsule_shape(a.shape);
   if (a.resume) check_resumed_membrane(a);
-  const TriMesh mesh = mesh_from_spec(a.mesh);
+  const CapsuleGeometry geometry = capsule_geometry(mesh_from_spec(a.mesh), a.shape);
+  const TriMesh& mesh = geometry.reference;
   if (bending) {
     // One evaluation on the initial shape, so that a mesh the method refuses (Method S: two
     // extraordinary vertices in a triangle) fails here, before the run folder is written.
     Points probe;
-    bending->forces(mesh.topology(), mesh.positions(), 1.0, probe);
+    bending->forces(mesh.topology(), geometry.initial, 1.0, probe);
   }
   if (!tolerance_warning.empty() && callbacks.on_note) callbacks.on_note("warning: " + tolerance_warning);
 
@@ -125,7 +127,7 @@ CapsuleRunResult run_shear(const ShearRunSpec& a, const ShearRunCallbacks& callb
   nlohmann::json summary_fields = {{"rtol", a.rtol}, {"atol", a.atol}};
   double lattice_nodes = 0, lattice_gamma = 0;
   if (a.solver == "bim") {
-    auto membrane = std::make_shared<const MembraneModel>(mesh, mp);
+    auto membrane = std::make_shared<const MembraneModel>(mesh, mp, geometry.initial);
     std::unique_ptr<Integrator> integrator;
     if (a.integrator == "rkc") {
       RkcOptions rk;
@@ -162,7 +164,7 @@ CapsuleRunResult run_shear(const ShearRunSpec& a, const ShearRunCallbacks& callb
     if (callbacks.on_note)
       for (const std::string& w : p.warnings) callbacks.on_note("warning: " + w);
     mp.volume_force = std::make_shared<const EspressoVolumeForce>(EspressoVolumeForce::for_membrane(mp.kS));
-    auto membrane = std::make_shared<const MembraneModel>(mesh, mp);
+    auto membrane = std::make_shared<const MembraneModel>(mesh, mp, geometry.initial);
     LbmSolverOptions lo;
     lo.radius = l.radius_lu;
     lo.lattice = p;
@@ -227,8 +229,18 @@ CapsuleRunResult run_shear(const ShearRunSpec& a, const ShearRunCallbacks& callb
   }
   // Likewise the quadrature: runs of the reference (all7) keep the identity they always had.
   if (a.bim_quadrature != "all7") o.arguments["bim_quadrature"] = a.bim_quadrature;
+  // Likewise the shape: the paper's sphere keeps the identity it always had; any other shape, tilt
+  // or reference is part of it.
+  if (!a.shape.is_default()) {
+    o.arguments["shape"] = a.shape.shape;
+    o.arguments["aspect"] = a.shape.aspect;
+    o.arguments["tilt"] = a.shape.tilt_degrees;
+    o.arguments["reference_shape"] = a.shape.reference;
+    o.arguments["reference_aspect"] = a.shape.reference_aspect;
+  }
   for (const auto& [key, value] : lattice_arguments.items()) o.arguments[key] = value;
   summary_fields["membrane_law"] = a.membrane;
+  summary_fields["capsule_shape"] = geometry.description;
   if (a.membrane == "skalak") summary_fields["skalak_c"] = a.skalak_c;
   o.summary_fields = summary_fields;
   o.on_note = callbacks.on_note;
