@@ -2,7 +2,9 @@
 // The membrane of a capsule as ONE force model (paper sections 2 and 4.2): in-plane elasticity
 // (an ElasticLaw: neo-Hookean by default, eqs. (18)-(21), or Skalak) + bending (any BendingMethod, eq. (10)
 // or an energy gradient) + an optional volume force, all relative to one reference state
-// (reference positions + shared Topology).
+// (reference positions + shared Topology). The capsule may start in another shape than its
+// reference (initial_positions(); a red blood cell stress-free as a spheroid): the volume force
+// keeps the initial shape's volume.
 //
 //   F = F_elastic + F_bending + F_volume   (nodal forces, N x 3)
 //   f = F / A_mixed                         (force density, eq. (14); Meyer's mixed area of the
