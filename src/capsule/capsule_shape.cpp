@@ -57,13 +57,25 @@ double unwrap_angle(double previous, double raw, double period) {
   return raw + period * std::round((previous - raw) / period);
 }
 
+namespace {
+// The angle (axis_angle) of the axis of the shear-plane section of the second moment: the
+// eigenvector of the 2 x 2 block (x, z) of M with the smaller eigenvalue (short) or the larger.
+double section_axis_angle(const Mat3& M, bool short_axis) {
+  Eigen::Matrix2d m;
+  m << M(0, 0), M(0, 2), M(2, 0), M(2, 2);
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(m);  // ascending
+  const Eigen::Vector2d v = eig.eigenvectors().col(short_axis ? 0 : 1);
+  return axis_angle(Vec3(v.x(), 0, v.y()));
+}
+}  // namespace
+
 MotionMarkers motion_markers(const Topology& t, const Points& x0) {
   const CapsuleShape s = capsule_shape(t, x0);
   MotionMarkers m;
   m.short_axis = s.b - s.c > s.a - s.b;
   Vec3 direction = Vec3::UnitX();
   if (s.a - s.c > 1e-9 * s.a) {
-    const double alpha = axis_angle(m.short_axis ? s.short_axis : s.long_axis);
+    const double alpha = section_axis_angle(s.second_moment, m.short_axis);
     direction = Vec3(std::cos(alpha), 0, -std::sin(alpha));
   }
   double best_value = -std::numeric_limits<double>::infinity();
@@ -78,7 +90,7 @@ MotionMarkers motion_markers(const Topology& t, const Points& x0) {
 }
 
 MotionAngles motion_angles(const CapsuleShape& s, const Points& x, const MotionMarkers& m) {
-  return {axis_angle(m.short_axis ? s.short_axis : s.long_axis), shear_plane_phase(row(x, m.node) - s.centroid)};
+  return {section_axis_angle(s.second_moment, m.short_axis), shear_plane_phase(row(x, m.node) - s.centroid)};
 }
 
 }  // namespace bendlab

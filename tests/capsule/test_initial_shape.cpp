@@ -140,3 +140,22 @@ TEST(InitialShape, AStressFreeBiconcaveReferenceHasNoElasticForceASphericalOneHa
   EXPECT_NEAR(prestressed.initial_volume(), enclosed_volume(m.topology(), sphere.initial), 1e-14);
   EXPECT_GT(prestressed.reference_volume(), 1.2 * prestressed.initial_volume());
 }
+
+TEST(InitialShape, TheAxisIsThatOfTheShearPlaneSectionEvenWhenTheBodyIsThinnerAcrossIt) {
+  // A disc tilted by 30 degrees whose in-plane thickness has grown beyond its width across the
+  // plane: the shortest 3D axis is e_y, but the axis followed is the section's short axis.
+  const TriMesh m = sphere_mesh(MeshFamily::MT1, 2);
+  const CapsuleGeometry g = capsule_geometry(m, spec("oblate", 30));
+  const MotionMarkers markers = motion_markers(m.topology(), g.initial);
+  ASSERT_TRUE(markers.short_axis);
+  const double alpha = 30 * M_PI / 180;
+  const Vec3 axis(std::sin(alpha), 0, std::cos(alpha)), rim(std::cos(alpha), 0, -std::sin(alpha));
+  Points x = m.positions();
+  for (Eigen::Index i = 0; i < x.rows(); ++i) {
+    const Vec3 p = row(x, i);
+    x.row(i) = (1.3 * p.x() * rim + 0.5 * p.y() * Vec3::UnitY() + 0.8 * p.z() * axis).transpose();
+  }
+  const CapsuleShape s = capsule_shape(m.topology(), x);
+  EXPECT_NEAR(std::abs(s.short_axis.y()), 1.0, 1e-12);
+  EXPECT_NEAR(motion_angles(s, x, markers).axis, alpha, 1e-12);
+}

@@ -47,9 +47,10 @@ double unwrap_angle(double previous, double raw, double period);
 
 /// What the time series follows of a body's motion (docs/conventions.md §2, "Orientation and
 /// tank-treading"), fixed by the initial shape:
-///  - the axis of symmetry: short_axis (the largest moment of inertia) when the initial shape is
-///    oblate-like (b - c > a - b: a disc, a red blood cell), else long_axis (a prolate body, and a
-///    sphere, which shear stretches along its long axis);
+///  - the axis of symmetry: the short axis (the largest moment of inertia) when the initial shape
+///    is oblate-like (b - c > a - b: a disc, a red blood cell), else the long axis (a prolate body,
+///    and a sphere, which shear stretches along its long axis), followed in the shear plane
+///    (motion_angles);
 ///  - the marked node: of the initial positions, the node farthest from the centroid along the
 ///    shear-plane direction perpendicular to that axis, (cos alpha, 0, -sin alpha) for the axis at
 ///    angle alpha (an untilted disc: e_x), i.e. on the rim of a disc, in the shear plane; for a
@@ -61,9 +62,14 @@ struct MotionMarkers {
 };
 MotionMarkers motion_markers(const Topology& topology, const Points& x0);
 
-/// The axis angle (axis_angle of the marked axis, period pi) and the node phase
-/// (shear_plane_phase of the marked node about the centroid, period 2 pi) of shape s of x, folded
-/// into their ranges; a time series unwraps them (unwrap_angle).
+/// The axis angle (period pi) and the node phase (shear_plane_phase of the marked node about the
+/// centroid, period 2 pi) of shape s of x, folded into their ranges; a time series unwraps them
+/// (unwrap_angle). The axis angle is that of the axis of the body's section by the shear plane:
+/// the eigenvector of the x-z block of the second moment M with the smaller eigenvalue (short
+/// axis: for an oblate body the largest moment of inertia about an axis in the plane) or the
+/// larger (long axis). For a body symmetric about the shear plane this is the 3D axis whenever
+/// that lies in the plane; unlike the 3D eigenvector it does not jump to e_y when a deformed
+/// cell becomes thinner across the plane than within it (which a swinging red blood cell does).
 struct MotionAngles {
   double axis = 0, node = 0;
 };
