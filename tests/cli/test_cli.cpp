@@ -744,4 +744,12 @@ TEST_F(Cli, ShearShapeOptionsAreCheckedAndPartOfTheRunsIdentity) {
   EXPECT_NE(r.err.find("reference_shape"), std::string::npos) << r.err;
   r = run(common + " --t-end 0.02 --resume");
   EXPECT_EQ(r.status, 0) << r.err;
+  // The lattice Boltzmann solver takes the shape too: it starts from the cell and keeps its volume.
+  const fs::path lbm = dir / "lbm";
+  r = run("shear --solver lbm --radius-lu 4 --box 4,4,4 --shape rbc --tilt 30 --reference-shape oblate --mesh mt1:320 "
+          "--G 0.1 --t-end 0.01 --snapshot-every 0.01 --sample-every 0.005 --no-plot --out " + lbm.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto l = nlohmann::json::parse(slurp(lbm / "summary.json"));
+  EXPECT_EQ(l.at("reference_shape"), "oblate");
+  EXPECT_NEAR(l.at("initial_volume").get<double>(), l.at("capsule_shape").at("mesh_volume").get<double>(), 1e-12);
 }
