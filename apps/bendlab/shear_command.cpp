@@ -1,4 +1,5 @@
-// bendlab shear: an initially spherical capsule (neo-Hookean or Skalak membrane + bending) in linear shear
+// bendlab shear: a capsule (neo-Hookean or Skalak membrane + bending; a sphere, or with --shape a red
+// blood cell or a spheroid, stress-free as it starts or in a --reference-shape) in linear shear
 // flow, by the boundary integral method (paper section 4, --solver bim) or the immersed-boundary
 // lattice Boltzmann method (section 4.3.2, --solver lbm). Argument parsing only: the run is
 // run_shear (bendlab/flow/shear_run.hpp), whose folder (timeseries.csv, snapshots,
@@ -36,6 +37,7 @@ struct ShearArgs {
   bool resume = false, overwrite = false, plot = true;
   LatticeRunSpec lattice;  // --solver lbm
   MembraneTermArgs terms;  // --c0, --ade-*
+  CapsuleShapeSpec shape;  // --shape, --aspect, --tilt, --reference-shape, --reference-aspect
   // Which options the user gave (the other solver's options are refused).
   bool given_tolerance = false, given_lattice = false;
 };
@@ -74,6 +76,7 @@ void shear(const ShearArgs& a) {
   if (a.rings != 0) spec.method_options["rings"] = std::to_string(a.rings);
   add_option_assignments(spec.method_options, a.options);
   spec.mesh = a.mesh;
+  spec.shape = a.shape;
   spec.G = a.G;
   spec.kappa_b_hat = a.kappa_b_hat;
   spec.kappa_b = a.kappa_b;
@@ -125,8 +128,9 @@ void shear(const ShearArgs& a) {
 
 const CommandRegistration registration([](CLI::App& app) {
   auto args = std::make_shared<ShearArgs>();
-  auto* cmd = app.add_subcommand("shear", "Simulate an initially spherical capsule (neo-Hookean or Skalak "
-                                          "membrane plus bending) in linear shear flow u = gamma z e_x at zero Reynolds number");
+  auto* cmd = app.add_subcommand("shear", "Simulate a capsule (neo-Hookean or Skalak membrane plus bending; "
+                                          "initially a sphere, or a red blood cell or spheroid with --shape) in "
+                                          "linear shear flow u = gamma z e_x at zero Reynolds number");
   cmd->add_option("--solver", args->solver,
                   "flow solver: bim (boundary integral method) or lbm (immersed-boundary lattice Boltzmann)")
       ->check(CLI::IsMember({"bim", "lbm"}))->capture_default_str();
@@ -139,6 +143,24 @@ const CommandRegistration registration([](CLI::App& app) {
   cmd->add_option("--mesh", args->mesh, "mt1:N or mt2:N (N triangles: 320, 1280, 5120, ...), inh:mt1 or inh:mt2 "
                                         "(320 triangles + 3 Rivara passes), or a mesh file (.off, .obj, .ply)")
       ->capture_default_str();
+  cmd->add_option("--shape", args->shape.shape,
+                  "initial shape: sphere (the paper's), rbc (the red blood cell of eq. (15)), oblate or prolate "
+                  "(spheroid of --aspect); rbc and spheroids are scaled to the volume 4 pi/3 of the unit sphere and "
+                  "are stress-free as they start unless --reference-shape says otherwise")
+      ->check(CLI::IsMember(capsule_shape_names()))->capture_default_str();
+  cmd->add_option("--aspect", args->shape.aspect,
+                  "c/a of a spheroidal --shape (axis of symmetry over equatorial half-axis; oblate < 1, default "
+                  "0.5; prolate > 1, default 2)");
+  cmd->add_option("--tilt", args->shape.tilt_degrees,
+                  "initial angle of the shape's axis of symmetry in the shear plane, in degrees from e_z towards e_x "
+                  "(the sense the flow turns it), in [-180, 180]")
+      ->capture_default_str();
+  cmd->add_option("--reference-shape", args->shape.reference,
+                  "stress-free shape of the elastic law: initial (the initial shape, the default), or sphere, rbc, "
+                  "oblate, prolate mapped from the same mesh points and scaled to the initial shape's area")
+      ->check(CLI::IsMember({"initial", "sphere", "rbc", "oblate", "prolate"}))->capture_default_str();
+  cmd->add_option("--reference-aspect", args->shape.reference_aspect,
+                  "c/a of a spheroidal --reference-shape (defaults as --aspect)");
   auto* membrane = cmd->add_option("--membrane", args->membrane,
                                    "in-plane elastic law: neo-hookean (the paper's, eq. 18) or skalak "
                                    "(Gs/4 (I1^2 + 2 I1 - 2 I2) + C Gs/4 I2^2 with Gs = kS/3)")

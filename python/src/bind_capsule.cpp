@@ -34,12 +34,18 @@ void bind_capsule(py::module_& m) {
          double rtol, double atol, bool resume, std::int64_t stop_after_steps, const py::object& progress,
          double progress_interval, const py::dict& method_options, const std::string& integrator,
          const std::string& membrane, double skalak_c, const std::string& bim_quadrature,
-         bool overwrite) -> py::object {
+         bool overwrite, const std::string& shape, double aspect, double tilt, const std::string& reference_shape,
+         double reference_aspect) -> py::object {
         ShearRunSpec spec;
         spec.folder = folder;
         spec.method = method;
         for (auto [k, v] : method_options) spec.method_options[py::str(k)] = option_value(v);
         spec.mesh = mesh;
+        spec.shape.shape = shape;
+        spec.shape.aspect = aspect;
+        spec.shape.tilt_degrees = tilt;
+        spec.shape.reference = reference_shape;
+        spec.shape.reference_aspect = reference_aspect;
         spec.G = G;
         spec.kappa_b_hat = kappa_b_hat;
         spec.kappa_b = kappa_b;
@@ -94,8 +100,12 @@ void bind_capsule(py::module_& m) {
       py::arg("stop_after_steps") = 0, py::arg("progress") = py::none(), py::arg("progress_interval") = 2.0,
       py::arg("method_options") = py::dict(), py::arg("integrator") = "cash-karp",
       py::arg("membrane") = "neo-hookean", py::arg("skalak_c") = 1.0,
-      py::arg("bim_quadrature") = "all7", py::arg("overwrite") = false,
-      "Runs an initially spherical capsule (membrane law `membrane`: 'neo-hookean', eqs. 18-21, or 'skalak' "
+      py::arg("bim_quadrature") = "all7", py::arg("overwrite") = false, py::arg("shape") = "sphere",
+      py::arg("aspect") = 0.0, py::arg("tilt") = 0.0, py::arg("reference_shape") = "initial",
+      py::arg("reference_aspect") = 0.0,
+      "Runs a capsule (initially the sphere, or `shape` 'rbc', 'oblate', 'prolate' of c/a `aspect`, its axis of "
+      "symmetry tilted by `tilt` degrees from e_z towards e_x, stress-free in `reference_shape` ('initial' or a "
+      "shape, of c/a `reference_aspect`), as `bendlab shear --shape` does; membrane law `membrane`: 'neo-hookean', eqs. 18-21, or 'skalak' "
       "with C = skalak_c; plus the bending method) in "
       "the shear flow u = gamma z e_x with the boundary integral method (eqs. 22-23), units R = mu = gamma "
       "= 1 (kS = 1/G, kB = kappa_b_hat / G), advanced by `integrator` ('cash-karp' or 'rkc'), the single layer's regular quadrature "
@@ -111,16 +121,18 @@ void bind_capsule(py::module_& m) {
       [](const std::filesystem::path& folder) {
         const std::vector<TimeSeriesRow> rows = read_time_series(folder / "timeseries.csv");
         const auto n = static_cast<Eigen::Index>(rows.size());
-        Scalars cols[8];
+        Scalars cols[10];
         for (Scalars& c : cols) c.resize(n);
         for (Eigen::Index i = 0; i < n; ++i) {
           const TimeSeriesRow& r = rows[static_cast<std::size_t>(i)];
-          const double v[8] = {r.t, r.D, r.theta, r.volume, r.area, r.E_bend, r.E_elastic, r.dt};
-          for (int k = 0; k < 8; ++k) cols[k][i] = v[k];
+          const double v[10] = {r.t, r.D, r.theta, r.volume, r.area, r.E_bend, r.E_elastic, r.dt, r.axis_angle,
+                                r.node_phase};
+          for (int k = 0; k < 10; ++k) cols[k][i] = v[k];
         }
         py::dict d;
-        const char* names[8] = {"gamma_t", "D", "theta", "volume", "area", "E_bend", "E_elastic", "dt"};
-        for (int k = 0; k < 8; ++k) d[names[k]] = take(std::move(cols[k]));
+        const char* names[10] = {"gamma_t", "D", "theta",  "volume",     "area",
+                                 "E_bend",  "E_elastic", "dt", "axis_angle", "node_phase"};
+        for (int k = 0; k < 10; ++k) d[names[k]] = take(std::move(cols[k]));
         return d;
       },
       py::arg("folder"), "The run's timeseries.csv as a dict of numpy arrays (gamma_t, D, theta, ...).");

@@ -103,3 +103,23 @@ def test_a_new_run_into_a_folder_holding_a_run_needs_overwrite(tmp_path):
     assert bendlab.read_summary(tmp_path / "run") == first
     second = bendlab.shear_run(tmp_path / "run", overwrite=True, **dict(quick, G=0.2))
     assert second["G"] == 0.2
+
+
+def test_a_red_blood_cell_from_python_resumes_from_the_cli_with_the_same_angles(tmp_path, cli):
+    rbc = dict(COMMON, shape="rbc", tilt=60.0, membrane="skalak", skalak_c=10.0, t_end=0.2)
+    full = bendlab.shear_run(tmp_path / "full", **rbc)
+    assert full["capsule_shape"]["shape"] == "rbc" and full["tilt"] == 60.0
+    assert 0.6 < full["capsule_shape"]["reduced_volume"] < 0.7
+    ts = bendlab.read_time_series(tmp_path / "full")
+    # The axis starts at the tilt and turns with the flow; the marked rim node is a quarter turn ahead.
+    assert ts["axis_angle"][0] == pytest.approx(np.radians(60.0), abs=0.01)
+    assert ts["axis_angle"][-1] > ts["axis_angle"][0]
+    assert ts["node_phase"][0] == pytest.approx(np.radians(150.0), abs=0.01)
+    assert bendlab.shear_run(tmp_path / "parts", stop_after_steps=3, **rbc) is None
+    cli("shear", "--shape", "rbc", "--tilt", "60", "--membrane", "skalak", "--skalak-c", "10", "--method", "C",
+        "--mesh", "mt1:320", "--G", "0.1", "--kappa-b-hat", "0.05", "--t-end", "0.2", "--snapshot-every", "0.1",
+        "--no-plot", "--resume", "--out", tmp_path / "parts")
+    assert bendlab.read_summary(tmp_path / "parts") == full
+    assert filecmp.cmp(tmp_path / "full" / "timeseries.csv", tmp_path / "parts" / "timeseries.csv", shallow=False)
+    with pytest.raises(Exception, match="--tilt"):
+        bendlab.shear_run(tmp_path / "bad", **dict(rbc, tilt=500.0))

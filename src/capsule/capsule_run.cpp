@@ -12,6 +12,7 @@
 
 #include "bendlab/capsule/capsule_shape.hpp"
 #include "bendlab/capsule/checkpoint.hpp"
+#include "bendlab/capsule/motion.hpp"
 #include "bendlab/core/atomic_file.hpp"
 #include "bendlab/core/folder_lock.hpp"
 #include "bendlab/geometry/measures.hpp"
@@ -21,13 +22,18 @@ namespace fs = std::filesystem;
 
 namespace bendlab {
 
-TimeSeriesRow capsule_sample(const MembraneModel& membrane, const Points& x, double t, double dt) {
+TimeSeriesRow capsule_sample(const MembraneModel& membrane, const Points& x, double t, double dt,
+                             const MotionMarkers* markers) {
   TimeSeriesRow r;
   r.t = t;
   r.dt = dt;
   const CapsuleShape shape = capsule_shape(membrane.topology(), x);
   r.D = shape.D;
   r.theta = shape.theta;
+  const MotionAngles angles = motion_angles(
+      shape, x, markers ? *markers : motion_markers(membrane.topology(), membrane.initial_positions()));
+  r.axis_angle = angles.axis;
+  r.node_phase = angles.node;
   r.volume = shape.volume;
   r.area = surface_area(membrane.topology(), x);
   const std::optional<double> eb = membrane.bending_energy(x);
@@ -206,6 +212,11 @@ CapsuleRunResult run_capsule(CapsuleSolver& solver, const CapsuleRunOptions& o) 
   }
 
   std::optional<TimeSeriesFile> series;
+  // The angles of the time series are unwrapped against the row before (the first row against the
+  // initial shape); a resumed run continues from the last kept row.
+  const MotionMarkers markers = motion_markers(membrane.topology(), membrane.initial_positions());
+  MotionAngles unwrapped = motion_angles(capsule_shape(membrane.topology(), membrane.initial_positions()),
+                                         membrane.initial_positions(), markers);
   if (o.resume) {
     if (!fs::exists(checkpoint_path))
       throw Error(fmt::format("resume: no checkpoint in '{}' to resume from", folder.string()));
@@ -220,6 +231,8 @@ CapsuleRunResult run_capsule(CapsuleSolver& solver, const CapsuleRunOptions& o) 
       kept = read_time_series_head(series_path, saved.steps);
     }
     const double largest_step = check_kept_rows(kept, saved.time, series_path, checkpoint_path.string());
+    if (!kept.empty() && std::isfinite(kept.back().axis_angle) && std::isfinite(kept.back().node_phase))
+      unwrapped = {kept.back().axis_angle, kept.back().node_phase};
     if (const std::string diff = compare_arguments(o.arguments, saved.arguments); !diff.empty())
       throw Error(fmt::format("resume: the arguments differ from the run in '{}': {}", folder.string(), diff));
     if (!(o.t_end > saved.time))
@@ -314,7 +327,13 @@ CapsuleRunResult run_capsule(CapsuleSolver& solver, const CapsuleRunOptions& o) 
       ++state.steps;
       ++steps_here;
       last_good_time = s.time;
-      const TimeSeriesRow row = capsule_sample(membrane, *s.positions, s.time, s.dt);
+      TimeSeriesRow row = capsule_sample(membrane, *s.positions, s.time, s.dt, &markers);
+      // raw + k period with k from the row before: the result depends on the row before through
+      // the integer k only, so a resumed run (which reads the row before back from the file)
+      // writes the very same values.
+      row.axis_angle = unwrap_angle(unwrapped.axis, row.axis_angle, M_PI);
+      row.node_phase = unwrap_angle(unwrapped.node, row.node_phase, 2 * M_PI);
+      unwrapped = {row.axis_angle, row.node_phase};
       if (series) series->append(row);
       state.steady.add(row);
       const bool at_end = s.time >= o.t_end - 1e-12;
@@ -380,8 +399,16 @@ CapsuleRunResult run_capsule(CapsuleSolver& solver, const CapsuleRunOptions& o) 
       {"rejected_steps", counters.rejected_steps},
       {"velocity_evaluations", counters.velocity_evaluations},
       {"final_volume", capsule_shape(membrane.topology(), solver.positions()).volume},
-      {"initial_volume", membrane.reference_volume()}};
+      {"initial_volume", membrane.initial_volume()}};
   for (const auto& [key, value] : fields.items()) summary[key] = value;
+  // The motion, from the time series as written (a resumed run reads the same file); a run resumed
+  // in a file of the older format has no angles, and no motion.
+  if (series && !series->legacy()) {
+    nlohmann::json motion = analyse_motion(read_time_series(series_path), o.t_end).to_json();
+    motion["marked_node"] = markers.node;
+    motion["axis"] = markers.short_axis ? "short" : "long";
+    summary["motion"] = motion;
+  }
   const nlohmann::json solver_fields = solver.summary();
   for (const auto& [key, value] : solver_fields.items()) summary[key] = value;
   AtomicFile f(folder / "summary.json");

@@ -11,12 +11,19 @@
 
 namespace bendlab {
 
-const char* time_series_header() { return "gamma_t,D,theta,volume,area,E_bend,E_elastic,dt"; }
+const char* time_series_header() { return "gamma_t,D,theta,volume,area,E_bend,E_elastic,dt,axis_angle,node_phase"; }
 
-std::string format_time_series_row(const TimeSeriesRow& r) {
-  return fmt::format("{:.10g},{:.12g},{:.12g},{:.15g},{:.15g},{},{:.12g},{:.6g}\n", r.t, r.D, r.theta, r.volume,
-                     r.area, std::isnan(r.E_bend) ? std::string("nan") : fmt::format("{:.12g}", r.E_bend),
-                     r.E_elastic, r.dt);
+const char* legacy_time_series_header() { return "gamma_t,D,theta,volume,area,E_bend,E_elastic,dt"; }
+
+std::string format_time_series_row(const TimeSeriesRow& r, bool legacy) {
+  const auto number = [](double v, int digits) {
+    return std::isnan(v) ? std::string("nan") : fmt::format("{:.{}g}", v, digits);
+  };
+  std::string s = fmt::format("{:.10g},{:.12g},{:.12g},{:.15g},{:.15g},{},{:.12g},{:.6g}", r.t, r.D, r.theta,
+                              r.volume, r.area, number(r.E_bend, 12), r.E_elastic, r.dt);
+  if (!legacy) s += fmt::format(",{},{}", number(r.axis_angle, 12), number(r.node_phase, 12));
+  s += '\n';
+  return s;
 }
 
 namespace {
@@ -31,22 +38,31 @@ double parse_number(const std::string& s, const std::string& source, std::int64_
   throw Error(fmt::format("'{}' line {}: '{}' is not a number", source, line, s.substr(0, 40)));
 }
 
-TimeSeriesRow parse_row(const std::string& line, const std::string& source, std::int64_t n) {
+TimeSeriesRow parse_row(const std::string& line, const std::string& source, std::int64_t n, bool legacy) {
   std::vector<double> v;
   std::istringstream s(line);
   for (std::string cell; std::getline(s, cell, ',');) v.push_back(parse_number(cell, source, n));
-  if (v.size() != 8) throw Error(fmt::format("'{}' line {}: {} columns, expected 8", source, n, v.size()));
-  return {v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7]};
+  const std::size_t columns = legacy ? 8 : 10;
+  if (v.size() != columns)
+    throw Error(fmt::format("'{}' line {}: {} columns, expected {}", source, n, v.size(), columns));
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  return {v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], legacy ? nan : v[8], legacy ? nan : v[9]};
 }
 
-// The header line of text, checked; `pos` is set to the start of the first row.
-void check_header(const std::string& text, const std::string& source, std::size_t& pos) {
+// Whether `header` is the older format's; throws for any other than the two.
+bool legacy_header(const std::string& header, const std::string& source) {
+  if (header == time_series_header()) return false;
+  if (header == legacy_time_series_header()) return true;
+  throw Error(fmt::format("'{}': header is '{}', expected '{}'", source, header.substr(0, 200), time_series_header()));
+}
+
+// The header line of text, checked; `pos` is set to the start of the first row. Returns whether
+// it is the older format's.
+bool check_header(const std::string& text, const std::string& source, std::size_t& pos) {
   const std::size_t end = text.find('\n');
-  const std::string header = text.substr(0, end);
-  if (header != time_series_header())
-    throw Error(
-        fmt::format("'{}': header is '{}', expected '{}'", source, header.substr(0, 200), time_series_header()));
+  const bool legacy = legacy_header(text.substr(0, end), source);
   pos = end == std::string::npos ? text.size() : end + 1;
+  return legacy;
 }
 }  // namespace
 
@@ -54,12 +70,10 @@ std::vector<TimeSeriesRow> parse_time_series(const std::string& text, const std:
   std::istringstream in(text);
   std::string header;
   std::getline(in, header);
-  if (header != time_series_header())
-    throw Error(
-        fmt::format("'{}': header is '{}', expected '{}'", source, header.substr(0, 200), time_series_header()));
+  const bool legacy = legacy_header(header, source);
   std::vector<TimeSeriesRow> rows;
   std::string line;
-  for (std::int64_t n = 2; std::getline(in, line); ++n) rows.push_back(parse_row(line, source, n));
+  for (std::int64_t n = 2; std::getline(in, line); ++n) rows.push_back(parse_row(line, source, n, legacy));
   return rows;
 }
 
@@ -67,7 +81,8 @@ std::vector<TimeSeriesRow> read_time_series(const std::filesystem::path& path) {
   return parse_time_series(read_regular_file(path, "the time series"), path.string());
 }
 
-TimeSeriesFile::TimeSeriesFile(std::filesystem::path path, std::int64_t rows) : path_(std::move(path)), rows_(rows) {
+TimeSeriesFile::TimeSeriesFile(std::filesystem::path path, std::int64_t rows, bool legacy)
+    : path_(std::move(path)), legacy_(legacy), rows_(rows) {
   out_.open(path_, std::ios::out | std::ios::app);
   if (!out_) throw Error(fmt::format("cannot append to '{}'", path_.string()));
 }
@@ -83,13 +98,13 @@ std::vector<TimeSeriesRow> read_time_series_head(const std::filesystem::path& pa
                                                  std::size_t* bytes) {
   const std::string text = read_regular_file(path, "the time series");
   std::size_t pos = 0;
-  check_header(text, path.string(), pos);
+  const bool legacy = check_header(text, path.string(), pos);
   std::vector<TimeSeriesRow> kept;
   for (std::int64_t k = 0; k < rows; ++k) {
     const std::size_t end = text.find('\n', pos);
     if (end == std::string::npos)
       throw Error(fmt::format("'{}' has {} complete rows, the checkpoint needs {}", path.string(), k, rows));
-    kept.push_back(parse_row(text.substr(pos, end - pos), path.string(), k + 2));
+    kept.push_back(parse_row(text.substr(pos, end - pos), path.string(), k + 2, legacy));
     pos = end + 1;
   }
   if (bytes) *bytes = pos;
@@ -101,10 +116,12 @@ TimeSeriesFile TimeSeriesFile::resume(const std::filesystem::path& path, std::in
   read_time_series_head(path, rows, &bytes);
   const std::string text = read_regular_file(path, "the time series");
   if (text.size() < bytes) throw Error(fmt::format("'{}' changed while it was read", path.string()));
+  std::size_t pos = 0;
+  const bool legacy = check_header(text, path.string(), pos);
   AtomicFile f(path);
   f.stream().write(text.data(), static_cast<std::streamsize>(bytes));
   f.commit();
-  return TimeSeriesFile(path, rows);
+  return TimeSeriesFile(path, rows, legacy);
 }
 
 TimeSeriesFile TimeSeriesFile::append_to(const std::filesystem::path& path, std::int64_t rows) {
@@ -112,7 +129,7 @@ TimeSeriesFile TimeSeriesFile::append_to(const std::filesystem::path& path, std:
 }
 
 void TimeSeriesFile::append(const TimeSeriesRow& row) {
-  out_ << format_time_series_row(row);
+  out_ << format_time_series_row(row, legacy_);
   out_.flush();
   if (!out_) throw Error(fmt::format("error while writing '{}' (row {})", path_.string(), rows_ + 1));
   ++rows_;

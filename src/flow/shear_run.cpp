@@ -106,8 +106,10 @@ CapsuleRunResult run_shear(const ShearRunSpec& a, const ShearRunCallbacks& callb
   if (a.resume && a.overwrite) throw Error("--resume and --overwrite exclude each other");
   if (a.resume && !fs::exists(a.folder / "checkpoint.json"))
     throw Error(fmt::format("--resume: no checkpoint in '{}' to resume from", a.folder.string()));
+  check_capsule_shape(a.shape);
   if (a.resume) check_resumed_membrane(a);
-  const TriMesh mesh = mesh_from_spec(a.mesh);
+  const CapsuleGeometry geometry = capsule_geometry(mesh_from_spec(a.mesh), a.shape);
+  const TriMesh& mesh = geometry.reference;
   // c0 and ADE (docs/conventions.md §5), in units of R = 1; A defaults to the initial area.
   BendingParameters terms(1.0);
   terms.c0 = a.c0;
@@ -116,7 +118,7 @@ CapsuleRunResult run_shear(const ShearRunSpec& a, const ShearRunCallbacks& callb
   terms.ade_da0 = a.ade_da0;
   if (terms.ade_alpha == 0 && (a.ade_d != 0 || a.ade_da0 != 0 || a.ade_area))
     throw Error("--ade-d, --ade-da0 and --ade-area need --ade-alpha > 0");
-  if (terms.has_ade()) terms.ade_area = a.ade_area ? *a.ade_area : surface_area(mesh.topology(), mesh.positions());
+  if (terms.has_ade()) terms.ade_area = a.ade_area ? *a.ade_area : surface_area(mesh.topology(), geometry.initial);
   terms.validate();
   if (!terms.plain() && (a.method == "none" || !(units.kappa_b_hat > 0)))
     throw Error("--c0 and --ade-alpha need a bending --method and --kappa-b-hat (or --kappa-b) > 0");
@@ -126,9 +128,9 @@ CapsuleRunResult run_shear(const ShearRunSpec& a, const ShearRunCallbacks& callb
     // extraordinary vertices in a triangle) fails here, before the run folder is written.
     Points probe;
     if (terms.plain())
-      bending->forces(mesh.topology(), mesh.positions(), 1.0, probe);
+      bending->forces(mesh.topology(), geometry.initial, 1.0, probe);
     else
-      bending->forces(mesh.topology(), mesh.positions(), terms, probe);
+      bending->forces(mesh.topology(), geometry.initial, terms, probe);
   }
   if (!tolerance_warning.empty() && callbacks.on_note) callbacks.on_note("warning: " + tolerance_warning);
 
@@ -144,7 +146,7 @@ CapsuleRunResult run_shear(const ShearRunSpec& a, const ShearRunCallbacks& callb
   nlohmann::json summary_fields = {{"rtol", a.rtol}, {"atol", a.atol}};
   double lattice_nodes = 0, lattice_gamma = 0;
   if (a.solver == "bim") {
-    auto membrane = std::make_shared<const MembraneModel>(mesh, mp);
+    auto membrane = std::make_shared<const MembraneModel>(mesh, mp, geometry.initial);
     std::unique_ptr<Integrator> integrator;
     if (a.integrator == "rkc") {
       RkcOptions rk;
@@ -181,7 +183,7 @@ CapsuleRunResult run_shear(const ShearRunSpec& a, const ShearRunCallbacks& callb
     if (callbacks.on_note)
       for (const std::string& w : p.warnings) callbacks.on_note("warning: " + w);
     mp.volume_force = std::make_shared<const EspressoVolumeForce>(EspressoVolumeForce::for_membrane(mp.kS));
-    auto membrane = std::make_shared<const MembraneModel>(mesh, mp);
+    auto membrane = std::make_shared<const MembraneModel>(mesh, mp, geometry.initial);
     LbmSolverOptions lo;
     lo.radius = l.radius_lu;
     lo.lattice = p;
@@ -251,8 +253,18 @@ CapsuleRunResult run_shear(const ShearRunSpec& a, const ShearRunCallbacks& callb
   if (terms.has_c0()) o.arguments["c0"] = terms.c0;
   if (terms.has_ade())
     o.arguments["ade"] = {{"alpha", terms.ade_alpha}, {"d", terms.ade_d}, {"dA0", terms.ade_da0}, {"A", terms.ade_area}};
+  // Likewise the shape: the paper's sphere keeps the identity it always had; any other shape, tilt
+  // or reference is part of it.
+  if (!a.shape.is_default()) {
+    o.arguments["shape"] = a.shape.shape;
+    o.arguments["aspect"] = a.shape.aspect;
+    o.arguments["tilt"] = a.shape.tilt_degrees;
+    o.arguments["reference_shape"] = a.shape.reference;
+    o.arguments["reference_aspect"] = a.shape.reference_aspect;
+  }
   for (const auto& [key, value] : lattice_arguments.items()) o.arguments[key] = value;
   summary_fields["membrane_law"] = a.membrane;
+  summary_fields["capsule_shape"] = geometry.description;
   if (a.membrane == "skalak") summary_fields["skalak_c"] = a.skalak_c;
   o.summary_fields = summary_fields;
   o.on_note = callbacks.on_note;

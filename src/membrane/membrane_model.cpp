@@ -30,7 +30,21 @@ MembraneModel::MembraneModel(const TriMesh& reference, MembraneParameters parame
       reference_(reference.positions()),
       parameters_(checked(parameters)),
       elastic_(make_elastic_law(parameters_.elastic_law, topology_, reference_, parameters_.kS, parameters_.skalak_c)),
-      reference_volume_(enclosed_volume(*topology_, reference_)) {}
+      reference_volume_(enclosed_volume(*topology_, reference_)),
+      initial_(reference_),
+      initial_volume_(reference_volume_) {}
+
+MembraneModel::MembraneModel(const TriMesh& reference, MembraneParameters parameters, const Points& initial)
+    : MembraneModel(reference, std::move(parameters)) {
+  if (initial.rows() != topology_->num_vertices() || initial.cols() != 3)
+    throw Error(fmt::format("membrane: {} initial positions for {} vertices", initial.rows(),
+                            topology_->num_vertices()));
+  require_finite_rows(initial, "membrane: the initial position");
+  initial_ = initial;
+  initial_volume_ = enclosed_volume(*topology_, initial_);
+  if (!(initial_volume_ > 0))
+    throw Error(fmt::format("membrane: the initial shape encloses the volume {}, not a positive one", initial_volume_));
+}
 
 void MembraneModel::forces(const Points& x, Points& force) const {
   if (x.rows() != topology_->num_vertices())
@@ -49,7 +63,7 @@ void MembraneModel::forces(const Points& x, Points& force) const {
     force += bending;
   }
   if (parameters_.volume_force != nullptr) {
-    parameters_.volume_force->add_forces(*topology_, x, reference_volume_, force);
+    parameters_.volume_force->add_forces(*topology_, x, initial_volume_, force);
     require_finite_rows(force, "membrane: the force with the volume force");
   }
 }
@@ -80,7 +94,7 @@ std::optional<double> MembraneModel::bending_energy(const Points& x) const {
 
 std::optional<double> MembraneModel::volume_energy(const Points& x) const {
   if (parameters_.volume_force == nullptr) return std::nullopt;
-  return parameters_.volume_force->energy(*topology_, x, reference_volume_);
+  return parameters_.volume_force->energy(*topology_, x, initial_volume_);
 }
 
 }  // namespace bendlab

@@ -368,7 +368,9 @@ TEST_F(Cli, ShearWritesItsFilesAndResumes) {
   EXPECT_GT(summary["D_steady"].get<double>(), 0);
   EXPECT_NEAR(summary["final_volume"].get<double>(), summary["initial_volume"].get<double>(),
               1e-10 * summary["initial_volume"].get<double>());
-  EXPECT_EQ(slurp(out / "timeseries.csv").rfind("gamma_t,D,theta,volume,area,E_bend,E_elastic,dt\n", 0), 0u);
+  EXPECT_EQ(slurp(out / "timeseries.csv").rfind("gamma_t,D,theta,volume,area,E_bend,E_elastic,dt,axis_angle,node_phase\n",
+                                                0),
+            0u);
   // Continue to 0.5: the rows up to 0.3 are kept and the series ends at 0.5.
   r = run("shear --mesh mt1:320 --G 0.1 --t-end 0.5 --snapshot-every 0.1 --no-plot --resume --out " + out.string());
   ASSERT_EQ(r.status, 0) << r.err;
@@ -405,7 +407,7 @@ TEST_F(Cli, ShearLbmWritesTheFilesOfABimRun) {
   EXPECT_NE(r.err.find("MLUPS"), std::string::npos) << r.err;
   for (const char* f : {"timeseries.csv", "summary.json", "shapes.pvd", "checkpoint.json", "snapshot_00000.vtp"})
     EXPECT_TRUE(fs::exists(lbm / f)) << f;
-  const std::string header = "gamma_t,D,theta,volume,area,E_bend,E_elastic,dt\n";
+  const std::string header = "gamma_t,D,theta,volume,area,E_bend,E_elastic,dt,axis_angle,node_phase\n";
   EXPECT_EQ(slurp(bim / "timeseries.csv").rfind(header, 0), 0u);
   EXPECT_EQ(slurp(lbm / "timeseries.csv").rfind(header, 0), 0u);
   const auto a = nlohmann::json::parse(slurp(bim / "summary.json"));
@@ -759,4 +761,40 @@ TEST_F(Cli, TwoDisjointSurfacesAreRefused) {
                  "several components", out);
   expect_refused(run("shear --mesh " + (dir / "two.off").string() + " --out " + (dir / "run").string()),
                  "several components", dir / "run");
+}
+
+TEST_F(Cli, ShearShapeOptionsAreCheckedAndPartOfTheRunsIdentity) {
+  const fs::path out = dir / "run";
+  expect_refused(run("shear --shape rbc --aspect 0.5 --out " + out.string()), "--aspect", out);
+  expect_refused(run("shear --shape oblate --aspect 1.5 --out " + out.string()), "--aspect", out);
+  expect_refused(run("shear --shape prolate --aspect 0.5 --out " + out.string()), "--aspect", out);
+  expect_refused(run("shear --shape rbc --tilt 200 --out " + out.string()), "--tilt", out);
+  expect_refused(run("shear --shape rbc --reference-aspect 0.5 --out " + out.string()), "--reference-aspect", out);
+  expect_refused(run("shear --shape rbc --reference-shape oblate --reference-aspect 2 --out " + out.string()),
+                 "--reference-aspect", out);
+  const std::string common = "shear --shape rbc --tilt 30 --mesh mt1:320 --G 0.1 --no-plot --out " + out.string();
+  CliRun r = run(common + " --t-end 0.01");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto summary = nlohmann::json::parse(slurp(out / "summary.json"));
+  EXPECT_EQ(summary.at("shape"), "rbc");
+  EXPECT_EQ(summary.at("tilt").get<double>(), 30.0);
+  EXPECT_EQ(summary.at("capsule_shape").at("shape"), "rbc");
+  EXPECT_TRUE(summary.contains("motion"));
+  // Another tilt, or another reference, is another run: refused on resume.
+  r = run("shear --shape rbc --tilt 40 --mesh mt1:320 --G 0.1 --no-plot --t-end 0.02 --resume --out " + out.string());
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.err.find("tilt"), std::string::npos) << r.err;
+  r = run(common + " --reference-shape sphere --t-end 0.02 --resume");
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.err.find("reference_shape"), std::string::npos) << r.err;
+  r = run(common + " --t-end 0.02 --resume");
+  EXPECT_EQ(r.status, 0) << r.err;
+  // The lattice Boltzmann solver takes the shape too: it starts from the cell and keeps its volume.
+  const fs::path lbm = dir / "lbm";
+  r = run("shear --solver lbm --radius-lu 4 --box 4,4,4 --shape rbc --tilt 30 --reference-shape oblate --mesh mt1:320 "
+          "--G 0.1 --t-end 0.01 --snapshot-every 0.01 --sample-every 0.005 --no-plot --out " + lbm.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto l = nlohmann::json::parse(slurp(lbm / "summary.json"));
+  EXPECT_EQ(l.at("reference_shape"), "oblate");
+  EXPECT_NEAR(l.at("initial_volume").get<double>(), l.at("capsule_shape").at("mesh_volume").get<double>(), 1e-12);
 }

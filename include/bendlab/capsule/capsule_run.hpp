@@ -4,8 +4,9 @@
 //   timeseries.csv   one row per accepted step (time_series.hpp), append-only, flushed per row
 //   snapshot_NNNNN.vtp + shapes.pvd   the shape every snapshot_every (and at t_end)
 //   checkpoint.json  the state at the last snapshot (checkpoint.hpp), for resume
-//   summary.json     the arguments, the steady statistics (steady_statistics.hpp), counters
-//                    and volumes: results only, no clock
+//   summary.json     the arguments, the steady statistics (steady_statistics.hpp), counters,
+//                    volumes and the motion (motion.hpp: tumbling, swinging, periods, from
+//                    timeseries.csv as written): results only, no clock
 //   timing.json      wall_seconds of all parts, wall_seconds_last_part, resumed
 //
 // A resumed run (options.resume) validates checkpoint.json as a whole, checks that its arguments
@@ -32,6 +33,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "bendlab/capsule/capsule_shape.hpp"
 #include "bendlab/capsule/capsule_solver.hpp"
 #include "bendlab/capsule/time_series.hpp"
 
@@ -88,8 +90,11 @@ struct CapsuleRunResult {
 };
 
 /// The time-series row of positions x at time t after a step dt: D and theta of the equivalent
-/// ellipsoid (capsule_shape.hpp), volume, area and the membrane's energies.
-TimeSeriesRow capsule_sample(const MembraneModel& membrane, const Points& x, double t, double dt);
+/// ellipsoid (capsule_shape.hpp), volume, area, the membrane's energies, and the axis angle and
+/// node phase of `markers` (default: motion_markers of the membrane's initial positions), folded
+/// into their ranges (the run unwraps them).
+TimeSeriesRow capsule_sample(const MembraneModel& membrane, const Points& x, double t, double dt,
+                             const MotionMarkers* markers = nullptr);
 
 /// Runs `solver` as described above. Throws bendlab::Error (before any file changes for bad
 /// options or a refused checkpoint).

@@ -1,7 +1,11 @@
 #pragma once
 // The time series of a capsule run, timeseries.csv:
-//   gamma_t,D,theta,volume,area,E_bend,E_elastic,dt
+//   gamma_t,D,theta,volume,area,E_bend,E_elastic,dt,axis_angle,node_phase
 // one row per accepted step; E_bend is `nan` where the bending method has no energy (or none).
+// axis_angle and node_phase (radians, unwrapped: continuous over the run) are the orientation of
+// the axis of symmetry in the shear plane and the phase of a marked membrane node about the
+// centroid (capsule_shape.hpp, MotionMarkers). A file of the older 8-column format (without them)
+// is still read (the angles NaN), and a run resumed in one keeps writing that format.
 //
 // The file is append-only during a run and flushed after every row; every write is checked (a
 // failed write throws bendlab::Error naming the file). Rewrites (resume: keep the rows up to the
@@ -20,12 +24,15 @@ struct TimeSeriesRow {
   double t = 0, D = 0, theta = 0, volume = 0, area = 0;
   double E_bend = 0;  ///< NaN where undefined
   double E_elastic = 0, dt = 0;
+  double axis_angle = 0, node_phase = 0;  ///< NaN in a file of the older format
 };
 
 /// The header line (without newline).
 const char* time_series_header();
-/// One row as written, with its newline.
-std::string format_time_series_row(const TimeSeriesRow& row);
+/// The header of the older format, without axis_angle and node_phase.
+const char* legacy_time_series_header();
+/// One row as written, with its newline (legacy: the older format's 8 columns).
+std::string format_time_series_row(const TimeSeriesRow& row, bool legacy = false);
 /// All rows of a time series file; throws bendlab::Error naming the file and line for a missing
 /// file, a wrong header or a malformed row.
 std::vector<TimeSeriesRow> read_time_series(const std::filesystem::path& path);
@@ -53,11 +60,14 @@ class TimeSeriesFile {
   /// Appends one row and flushes; throws bendlab::Error if the write fails.
   void append(const TimeSeriesRow& row);
   std::int64_t rows() const { return rows_; }
+  /// Whether the file has the older header (and rows are written in that format).
+  bool legacy() const { return legacy_; }
   const std::filesystem::path& path() const { return path_; }
 
  private:
-  TimeSeriesFile(std::filesystem::path path, std::int64_t rows);
+  TimeSeriesFile(std::filesystem::path path, std::int64_t rows, bool legacy = false);
   std::filesystem::path path_;
+  bool legacy_ = false;
   std::ofstream out_;
   std::int64_t rows_ = 0;
 };

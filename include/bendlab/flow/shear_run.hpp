@@ -1,5 +1,6 @@
 #pragma once
-// The paper's section 4 run, as one library call: an initially spherical capsule (elastic law
+// The paper's section 4 run, as one library call: an initially spherical capsule (or, beyond the
+// paper, a red blood cell or a spheroid with a reference shape of its own, capsule/initial_shape.hpp) (elastic law
 // (neo-Hookean, or Skalak beyond the paper) +
 // bending method) in the shear flow u = gamma z e_x, in the units of capsule/shear_units.hpp
 // (R = mu = gamma = 1, kS = 1/G, kB = kappa_b_hat / G), solved by a flow solver behind
@@ -15,6 +16,7 @@
 
 #include "bendlab/bending/bending_method.hpp"
 #include "bendlab/capsule/capsule_run.hpp"
+#include "bendlab/capsule/initial_shape.hpp"
 #include "bendlab/flow/lbm/lbm_capsule_solver.hpp"
 
 namespace bendlab {
@@ -41,6 +43,9 @@ struct ShearRunSpec {
   std::string membrane = "neo-hookean";  ///< in-plane elastic law: "neo-hookean" or "skalak" (elasticity/)
   double skalak_c = 1;                 ///< the Skalak law's C (> -1/2); only with membrane = "skalak"
   std::string mesh = "mt1:1280";       ///< mesh_spec.hpp: mt1:N, mt2:N, octa:N, inh:mt1, inh:mt2 or a file
+  /// The initial shape, its tilt and the stress-free reference shape (capsule/initial_shape.hpp);
+  /// the default is the paper's sphere.
+  CapsuleShapeSpec shape;
   double G = 0.1;                      ///< mu gamma R / kS
   std::optional<double> kappa_b_hat;   ///< kB / (R^2 kS) (exclusive with kappa_b)
   std::optional<double> kappa_b;       ///< dimensional kB

@@ -2,7 +2,9 @@
 // The membrane of a capsule as ONE force model (paper sections 2 and 4.2): in-plane elasticity
 // (an ElasticLaw: neo-Hookean by default, eqs. (18)-(21), or Skalak) + bending (any BendingMethod, eq. (10)
 // or an energy gradient) + an optional volume force, all relative to one reference state
-// (reference positions + shared Topology).
+// (reference positions + shared Topology). The capsule may start in another shape than its
+// reference (initial_positions(); a red blood cell stress-free as a spheroid): the volume force
+// keeps the initial shape's volume.
 //
 //   F = F_elastic + F_bending + F_volume   (nodal forces, N x 3)
 //   f = F / A_mixed                         (force density, eq. (14); Meyer's mixed area of the
@@ -56,6 +58,11 @@ class MembraneModel {
   /// bendlab::Error for kS <= 0, kB < 0, non-finite moduli, kB > 0 without a bending method, an
   /// unknown elastic law or a degenerate reference triangle.
   MembraneModel(const TriMesh& reference, MembraneParameters parameters);
+  /// A capsule that starts in another shape than its stress-free one (a red blood cell whose
+  /// reference is a spheroid, docs/conventions.md §2): `initial` (N x 3) are the positions a
+  /// solver starts from and the volume its volume correction keeps. Throws as above, and for
+  /// initial positions of the wrong size, not finite or enclosing no positive volume.
+  MembraneModel(const TriMesh& reference, MembraneParameters parameters, const Points& initial);
 
   /// F (resized to N x 3) for positions x. Throws NonFiniteError (core/finite_check.hpp) naming
   /// the stage (elastic law, bending method, volume force) and the first vertex where a position
@@ -83,6 +90,11 @@ class MembraneModel {
   const Points& reference_positions() const { return reference_; }
   /// Enclosed volume of the reference shape.
   double reference_volume() const { return reference_volume_; }
+  /// The positions a solver starts from: the reference positions unless given apart.
+  const Points& initial_positions() const { return initial_; }
+  /// Enclosed volume of the initial shape: the volume the solvers' volume correction (BIM's
+  /// rescaling, the volume force) keeps; equal to reference_volume() unless the shapes differ.
+  double initial_volume() const { return initial_volume_; }
   int num_vertices() const { return topology_->num_vertices(); }
 
  private:
@@ -91,6 +103,8 @@ class MembraneModel {
   MembraneParameters parameters_;
   std::shared_ptr<const ElasticLaw> elastic_;
   double reference_volume_ = 0;
+  Points initial_;
+  double initial_volume_ = 0;
 };
 
 }  // namespace bendlab

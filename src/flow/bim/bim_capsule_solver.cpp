@@ -23,7 +23,7 @@ const std::shared_ptr<const MembraneModel>& checked(const std::shared_ptr<const 
 }
 
 Points centred(const MembraneModel& m) {
-  Points x = m.reference_positions();
+  Points x = m.initial_positions();
   x.rowwise() -= volume_centroid(m.topology(), x).transpose();
   return x;
 }
@@ -63,7 +63,7 @@ bool BimCapsuleSolver::advance(double t_end, const OnStep& on_step) {
   if (!(t_end > t_)) return true;
   const int n = membrane_->num_vertices();
   const Topology& topology = membrane_->topology();
-  const double volume0 = membrane_->reference_volume();
+  const double volume0 = membrane_->initial_volume();
   const std::int64_t rejected_before = counters_.rejected_steps;
   // The state vector is the row-major N x 3 position array, flattened.
   Eigen::VectorXd y = Eigen::Map<const Eigen::VectorXd>(x_.data(), 3 * n);

@@ -35,7 +35,7 @@ void IbCapsuleSolver::place_capsule(double shear_rate, double viscosity) {
   gamma_ = shear_rate;
   force_scale_ = viscosity * gamma_ * options_.radius * options_.radius;
   sample_steps_ = std::max<std::int64_t>(1, std::llround(options_.sample_every / gamma_));
-  x_ = membrane_->reference_positions();
+  x_ = membrane_->initial_positions();
   x_.rowwise() -= volume_centroid(membrane_->topology(), x_).transpose();
   X_ = options_.radius * x_;
   X_.rowwise() += options_.offset.transpose();
