@@ -15,6 +15,13 @@
 //                  fraction of the bandwidth bound of this layout that the kernel reaches.
 //   BM_LbmStep<collision>Unpadded  the same with the slots num_nodes() apart (pad_slots = false),
 //                  the plain layout the padded one is measured against.
+//   BM_LbmStepTRTPeriodic/<threads>  one TRT step of a wall-free (fully periodic) 128^3 box with a
+//                  body force: the reference of the channel and tube lattices.
+//   BM_LbmStepTube/<threads>  one TRT step of the tube of HemoCell's pipeflow example (25 um across,
+//                  50 um long at dx = 0.5 um: D = 50 dx, 100 x 52 x 52 nodes) driven by a body
+//                  force, with the interpolated bounce-back of its circular wall. MLUPS counts fluid
+//                  nodes only; its ratio to BM_LbmStepTRTPeriodic's on as many threads is the
+//                  wall cost (target: at least 0.7; scripts/make_lbm_performance_doc.py).
 //   BM_MembraneIbm/<threads>  the capsule's part of one IB-LBM step in the paper's full-size case:
 //                  5120 triangles (2562 nodes) of R = 13.5 dx centred in the same 128^3 box,
 //                  neo-Hookean + bending (method A, ESPResSo's tribend) + ESPResSo's volume force,
@@ -33,6 +40,7 @@
 #include "bendlab/bending/bending_method.hpp"
 #include "bendlab/flow/lbm/immersed_boundary.hpp"
 #include "bendlab/flow/lbm/lattice.hpp"
+#include "bendlab/flow/lbm/section_walls.hpp"
 #include "bendlab/membrane/espresso_volume_force.hpp"
 #include "bendlab/membrane/membrane_model.hpp"
 #include "bendlab/mesh/generators.hpp"
@@ -176,6 +184,45 @@ void BM_LbmStepRegularized(benchmark::State& state) { lbm_step(state, Collision:
 void BM_LbmStepBGKUnpadded(benchmark::State& state) { lbm_step(state, Collision::BGK, false); }
 void BM_LbmStepRegularizedUnpadded(benchmark::State& state) { lbm_step(state, Collision::Regularized, false); }
 
+void BM_LbmStepTRTPeriodic(benchmark::State& state) {
+  const int threads = static_cast<int>(state.range(0));
+  omp_set_num_threads(threads);
+  LatticeConfig c;
+  c.nx = c.ny = c.nz = 128;
+  c.tau = 0.9;
+  c.walls = false;
+  c.collision = Collision::TRT;
+  c.body_force = Vec3(1e-7, 0, 0);
+  Lattice L(c);
+  L.run(2);
+  for (auto _ : state) L.step();
+  const double updates = static_cast<double>(state.iterations()) * static_cast<double>(L.num_fluid_nodes());
+  state.counters["MLUPS"] = benchmark::Counter(updates * 1e-6, benchmark::Counter::kIsRate);
+  if (triad_traffic.count(threads) && state.iterations() > 0) {
+    state.counters["bound_fraction"] = benchmark::Counter(updates * kBytesPerUpdate * 1e-9 / triad_traffic[threads], benchmark::Counter::kIsRate);
+  }
+}
+
+void BM_LbmStepTube(benchmark::State& state) {
+  const int threads = static_cast<int>(state.range(0));
+  omp_set_num_threads(threads);
+  LatticeConfig c;
+  c.nx = 100;
+  c.ny = c.nz = 52;
+  c.tau = 0.9;
+  c.walls = false;
+  c.collision = Collision::TRT;
+  c.body_force = Vec3(1e-7, 0, 0);
+  c.section = std::make_shared<TubeWall>(25.0);
+  Lattice L(c);
+  L.run(2);
+  for (auto _ : state) L.step();
+  const double updates = static_cast<double>(state.iterations()) * static_cast<double>(L.num_fluid_nodes());
+  state.counters["MLUPS"] = benchmark::Counter(updates * 1e-6, benchmark::Counter::kIsRate);
+  state.counters["fluid_nodes"] = static_cast<double>(L.num_fluid_nodes());
+  state.counters["wall_link_rows"] = static_cast<double>(L.num_wall_links());
+}
+
 // Measures the triad once per thread count for bound_fraction (not reported by itself).
 void BM_TriadReference(benchmark::State& state) {
   const int threads = static_cast<int>(state.range(0));
@@ -204,6 +251,8 @@ BENCHMARK(BM_LbmStepRegularized)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark:
 BENCHMARK(BM_LbmStepBGKUnpadded)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_LbmStepRegularizedUnpadded)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_MembraneIbm)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_LbmStepTRTPeriodic)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_LbmStepTube)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

@@ -224,6 +224,47 @@ struct Regularized {
   LBM_INLINE void operator()(double* f, double Fx, double Fy, double Fz) const { apply(f, Fx, Fy, Fz, Pairs{}); }
 };
 
+// TRT + Guo (Ginzburg's two relaxation times): per pair of opposite directions (c, -c) the even
+// part f+ = (f_c + f_-c)/2 relaxes with omega+ = 1/tau and the odd part f- = (f_c - f_-c)/2 with
+// omega-; the Guo source w [3 (c - u).F + 9 (c.u)(c.F)] splits into its even part
+// w (-3 u.F + 9 A B) and odd part 3 w B (A = c.u, B = c.F), weighted by 1 - omega+/2 and
+// 1 - omega-/2:
+//   f_+-c* = [(1 - omega+) f+ + even] +- [(1 - omega-) f- + odd],
+//   even = w (omega+ rho (1 - 1.5 u.u + 4.5 A^2) + a+ (-3 u.F + 9 A B)), odd = w (3 omega- rho A + 3 a- B).
+struct Trt {
+  double op, om;  // omega+, omega-
+  template <std::size_t K>
+  LBM_INLINE void relax_pair(double* f, const double* s, const double* d, double e0, double e2, double e4,
+                             double o1, double o3, double ux, double uy, double uz, double Fx, double Fy, double Fz) const {
+    constexpr int q = 2 * static_cast<int>(K) + 1, qb = q + 1;
+    static_assert(opposite(q) == qb);
+    constexpr int X = kCx[q], Y = kCy[q], Z = kCz[q];
+    const double A = cdot<X, Y, Z>(ux, uy, uz);
+    const double B = cdot<X, Y, Z>(Fx, Fy, Fz);
+    const double even = 0.5 * (1.0 - op) * s[K] + kW[q] * (e0 + A * (e2 * A + e4 * B));
+    const double odd = 0.5 * (1.0 - om) * d[K] + kW[q] * (o1 * A + o3 * B);
+    f[q] = even + odd;
+    f[qb] = even - odd;
+  }
+  template <std::size_t... K>
+  LBM_INLINE void apply(double* f, double Fx, double Fy, double Fz, std::index_sequence<K...>) const {
+    const Pairs k;
+    const PairSums p = pair_sums(f, k);
+    const double rho = f[0] + pair_total(p.s, k);
+    const double jx = pair_moment<kCx>(p.d, k), jy = pair_moment<kCy>(p.d, k), jz = pair_moment<kCz>(p.d, k);
+    const double ir = 1.0 / rho;
+    const double ux = (jx + 0.5 * Fx) * ir, uy = (jy + 0.5 * Fy) * ir, uz = (jz + 0.5 * Fz) * ir;
+    const double uu = ux * ux + uy * uy + uz * uz, uF = ux * Fx + uy * Fy + uz * Fz;
+    const double ap = 1.0 - 0.5 * op, am = 1.0 - 0.5 * om;
+    const double orho = op * rho;
+    const double e0 = orho * (1.0 - 1.5 * uu) - 3.0 * ap * uF, e2 = 4.5 * orho, e4 = 9.0 * ap;
+    const double o1 = 3.0 * om * rho, o3 = 3.0 * am;
+    f[0] = (1.0 - op) * f[0] + kW[0] * e0;
+    (relax_pair<K>(f, p.s, p.d, e0, e2, e4, o1, o3, ux, uy, uz, Fx, Fy, Fz), ...);
+  }
+  LBM_INLINE void operator()(double* f, double Fx, double Fy, double Fz) const { apply(f, Fx, Fy, Fz, Pairs{}); }
+};
+
 constexpr std::size_t kParallelNodes = std::size_t{1} << 15;
 
 struct StepArgs {
@@ -234,6 +275,8 @@ struct StepArgs {
   bool walls, odd;
   double v;
   const double* F[3];
+  const std::uint8_t* solid;  // per row j + ny k, or null (no cross-section)
+  double g[3];                // the uniform body force
 };
 
 // Where each of the 19 populations of a run of nodes x0..x1-1 in one row is read from and written
@@ -252,7 +295,9 @@ LBM_INLINE int wrap(int i, int n) { return i < 0 ? i + n : (i >= n ? i - n : i);
 
 template <bool kAdd, class Coll, std::size_t... Q>
 LBM_INLINE void row_kernel_impl(const RowPlan& p, const double* __restrict Fx, const double* __restrict Fy,
-                            const double* __restrict Fz, int x0, int x1, const Coll& coll, std::index_sequence<Q...>) {
+                            const double* __restrict Fz, const double* g, int x0, int x1, const Coll& coll,
+                            std::index_sequence<Q...>) {
+  const double gx = g[0], gy = g[1], gz = g[2];
   const double* r[kQ] = {(p.rbase[Q] + (p.roff[Q] + x0))...};
   double* w[kQ] = {(p.wbase[Q] + (p.woff[Q] + x0))...};
   const double* fx = Fx + x0;
@@ -268,7 +313,7 @@ LBM_INLINE void row_kernel_impl(const RowPlan& p, const double* __restrict Fx, c
     } else {
       ((f[Q] = r[Q][x]), ...);
     }
-    coll(f, fx[x], fy[x], fz[x]);
+    coll(f, fx[x] + gx, fy[x] + gy, fz[x] + gz);
     if constexpr (kAdd) {
       ((w[Q][x] = f[Q] + p.wadd[Q]), ...);
     } else {
@@ -278,13 +323,14 @@ LBM_INLINE void row_kernel_impl(const RowPlan& p, const double* __restrict Fx, c
 }
 
 template <bool kAdd, class Coll>
-LBM_INLINE void row_kernel(const RowPlan& p, const double* Fx, const double* Fy, const double* Fz, int x0, int x1, const Coll& coll) {
-  row_kernel_impl<kAdd>(p, Fx, Fy, Fz, x0, x1, coll, Directions{});
+LBM_INLINE void row_kernel(const RowPlan& p, const double* Fx, const double* Fy, const double* Fz, const double* g,
+                           int x0, int x1, const Coll& coll) {
+  row_kernel_impl<kAdd>(p, Fx, Fy, Fz, g, x0, x1, coll, Directions{});
 }
 
 // The odd (streaming) step's plan for row (j, k): the offsets of the interior nodes (x - c_x
 // stays in the row; row_end_plan derives the two ends). Returns whether any link of the row meets
-// a wall.
+// a moving flat wall (whose bounce-back adds a constant); a resting cross-section wall adds nothing.
 bool odd_plan(const StepArgs& a, int j, int k, RowPlan& p) {
   const std::size_t n = a.stride;
   p.rwall = p.wwall = 0;
@@ -305,9 +351,18 @@ bool odd_plan(const StepArgs& a, int j, int k, RowPlan& p) {
       ks = wrap(ks, a.nz);
       const int js = wrap(j - kCy[q], a.ny);
       const std::ptrdiff_t srow = static_cast<std::ptrdiff_t>(a.nx) * (js + static_cast<std::ptrdiff_t>(a.ny) * ks);
-      p.rbase[q] = a.f + qb * n;
-      p.roff[q] = srow - kCx[q];
-      p.radd[q] = 0.0;
+      if (a.solid && a.solid[js + static_cast<std::ptrdiff_t>(a.ny) * ks]) {
+        // A resting wall of the cross-section: plain bounce-back here, moved to the wall's true
+        // position after the step (Lattice::apply_interpolated_bounce_back).
+        p.rbase[q] = a.f + q * n;
+        p.roff[q] = row;
+        p.radd[q] = 0.0;
+        p.rwall |= 1u << q;
+      } else {
+        p.rbase[q] = a.f + qb * n;
+        p.roff[q] = srow - kCx[q];
+        p.radd[q] = 0.0;
+      }
     }
     // Write post-collision population q to x + c_q (slot q), or reflect it at the wall into
     // slot qbar of this node, where the next (even) step reads population qbar.
@@ -323,9 +378,16 @@ bool odd_plan(const StepArgs& a, int j, int k, RowPlan& p) {
       kd = wrap(kd, a.nz);
       const int jd = wrap(j + kCy[q], a.ny);
       const std::ptrdiff_t drow = static_cast<std::ptrdiff_t>(a.nx) * (jd + static_cast<std::ptrdiff_t>(a.ny) * kd);
-      p.wbase[q] = a.f + q * n;
-      p.woff[q] = drow + kCx[q];
-      p.wadd[q] = 0.0;
+      if (a.solid && a.solid[jd + static_cast<std::ptrdiff_t>(a.ny) * kd]) {
+        p.wbase[q] = a.f + qb * n;
+        p.woff[q] = row;
+        p.wadd[q] = 0.0;
+        p.wwall |= 1u << q;
+      } else {
+        p.wbase[q] = a.f + q * n;
+        p.woff[q] = drow + kCx[q];
+        p.wadd[q] = 0.0;
+      }
     }
   }
   return wall;
@@ -354,21 +416,22 @@ LBM_INLINE void process_rows_impl(const StepArgs& a, int row0, int row1, const C
     const double* Fx = a.F[0] + row;
     const double* Fy = a.F[1] + row;
     const double* Fz = a.F[2] + row;
+    if (a.solid && a.solid[r]) continue;
     if (!a.odd) {
       for (int q = 0; q < kQ; ++q) {
         p.rbase[q] = a.f + q * a.stride;
         p.wbase[q] = a.f + opposite(q) * a.stride;
         p.roff[q] = p.woff[q] = row;
       }
-      row_kernel<false>(p, Fx, Fy, Fz, 0, a.nx, coll);
+      row_kernel<false>(p, Fx, Fy, Fz, a.g, 0, a.nx, coll);
       continue;
     }
     const bool wall = odd_plan(a, j, k, p);
     if (a.nx > 2) {
       if (wall) {
-        row_kernel<true>(p, Fx, Fy, Fz, 1, a.nx - 1, coll);
+        row_kernel<true>(p, Fx, Fy, Fz, a.g, 1, a.nx - 1, coll);
       } else {
-        row_kernel<false>(p, Fx, Fy, Fz, 1, a.nx - 1, coll);
+        row_kernel<false>(p, Fx, Fy, Fz, a.g, 1, a.nx - 1, coll);
       }
     }
     // The row ends, where x -+ c_x wraps: x = 0 and (if it is another node) x = nx - 1.
@@ -376,9 +439,9 @@ LBM_INLINE void process_rows_impl(const StepArgs& a, int row0, int row1, const C
       const int xe = e == 0 ? 0 : a.nx - 1;
       row_end_plan(p, a.nx, xe, end);
       if (wall) {
-        row_kernel<true>(end, Fx, Fy, Fz, xe, xe + 1, coll);
+        row_kernel<true>(end, Fx, Fy, Fz, a.g, xe, xe + 1, coll);
       } else {
-        row_kernel<false>(end, Fx, Fy, Fz, xe, xe + 1, coll);
+        row_kernel<false>(end, Fx, Fy, Fz, a.g, xe, xe + 1, coll);
       }
     }
   }
@@ -402,7 +465,11 @@ BENDLAB_LBM_CLONES void process_rows_reg(const StepArgs& a, int row0, int row1, 
 }
 void process_rows(const StepArgs& a, int row0, int row1, const Bgk<false>& c) { process_rows_bgk(a, row0, row1, c); }
 void process_rows(const StepArgs& a, int row0, int row1, const Bgk<true>& c) { process_rows_bgk1(a, row0, row1, c); }
+BENDLAB_LBM_CLONES void process_rows_trt(const StepArgs& a, int row0, int row1, const Trt& c) {
+  process_rows_impl(a, row0, row1, c);
+}
 void process_rows(const StepArgs& a, int row0, int row1, const Regularized& c) { process_rows_reg(a, row0, row1, c); }
+void process_rows(const StepArgs& a, int row0, int row1, const Trt& c) { process_rows_trt(a, row0, row1, c); }
 
 }  // namespace
 
@@ -415,9 +482,15 @@ Lattice::Lattice(const LatticeConfig& config) : config_(config) {
   }
   if (!std::isfinite(config.wall_velocity)) throw Error("LBM wall velocity is not finite");
   if (config.walls && config.nz < 2) throw Error("LBM lattice between walls needs at least 2 layers in z");
+  if (!config.body_force.allFinite()) throw Error("LBM body force is not finite");
+  if (config.collision == Collision::TRT && !(config.trt_magic > 0 && std::isfinite(config.trt_magic))) {
+    throw Error(fmt::format("LBM TRT magic parameter {} must be finite and positive", config.trt_magic));
+  }
   collision_ = config.collision;
   if (collision_ == Collision::Auto) collision_ = config.tau == 1.0 ? Collision::BGK : Collision::Regularized;
   n_ = static_cast<std::size_t>(config.nx) * config.ny * config.nz;
+  fluid_nodes_ = n_;
+  build_section();
   // A multiple of 4 KiB (512 doubles) plus 9 cache lines: the slots' starts fall on 19 (and the
   // force components' on 3) different cache-line offsets modulo 4 KiB and modulo any larger power
   // of two up to 9 * 64 lines, so a row's streams neither alias nor share cache sets.
@@ -425,6 +498,105 @@ Lattice::Lattice(const LatticeConfig& config) : config_(config) {
   f_.assign(kQ * stride_, 0.0);
   force_.assign(3 * stride_, 0.0);
   initialise([](const Vec3&) { return Vec3::Zero(); });
+}
+
+void Lattice::build_section() {
+  if (!config_.section) return;
+  const int ny = config_.ny, nz = config_.nz;
+  solid_rows_.assign(static_cast<std::size_t>(ny) * nz, 0);
+  std::size_t fluid_rows = 0;
+  for (int k = 0; k < nz; ++k) {
+    for (int j = 0; j < ny; ++j) {
+      const Vec3 x = position(0, j, k);
+      const bool solid = config_.section->solid(x.y(), x.z());
+      solid_rows_[j + static_cast<std::size_t>(ny) * k] = solid ? 1 : 0;
+      fluid_rows += solid ? 0 : 1;
+    }
+  }
+  if (fluid_rows == 0) throw Error(fmt::format("LBM lattice {} x {} x {}: the {} leaves no fluid", config_.nx, ny, nz, config_.section->describe()));
+  fluid_nodes_ = fluid_rows * static_cast<std::size_t>(config_.nx);
+  // Every link of a fluid row must reach what the section describes at its unwrapped end (the wall
+  // fraction is measured along the unwrapped link); where a periodic wrap finds otherwise, the
+  // section does not close inside the box.
+  for (int k = 0; k < nz; ++k) {
+    for (int j = 0; j < ny; ++j) {
+      if (solid_rows_[j + static_cast<std::size_t>(ny) * k]) continue;
+      for (int q = 1; q < kQ; ++q) {
+        if (kCy[q] == 0 && kCz[q] == 0) continue;
+        const int jd = j + kCy[q], kd = k + kCz[q];
+        if (config_.walls && (kd < 0 || kd >= nz)) continue;  // a flat wall: plain halfway bounce-back
+        const bool solid = solid_rows_[wrap(jd, ny) + static_cast<std::size_t>(ny) * wrap(kd, nz)] != 0;
+        const Vec3 x = position(0, j, k);
+        // A link that wraps around a periodic axis must find there what the section puts beyond
+        // the box's edge.
+        if (solid != config_.section->solid(x.y() + kCy[q], x.z() + kCz[q])) {
+          throw Error(fmt::format("LBM lattice {} x {} x {}: the {} does not close inside the box (fluid row at y = {}, z = {})",
+                                  config_.nx, ny, nz, config_.section->describe(), x.y(), x.z()));
+        }
+        if (!solid) continue;
+        const int jb = wrap(j - kCy[q], ny), kb = k - kCz[q];
+        const bool back_in_wall = config_.walls && (kb < 0 || kb >= nz);
+        const int kbw = wrap(kb, nz);
+        const bool back_fluid = !back_in_wall && !solid_rows_[jb + static_cast<std::size_t>(ny) * kbw];
+        const double fraction = config_.section->link_fraction(x.y(), x.z(), kCy[q], kCz[q]);
+        wall_links_.push_back({j, k, q, fraction, back_fluid, jb, kbw});
+      }
+    }
+  }
+  wall_buffer_.resize(wall_links_.size() * static_cast<std::size_t>(config_.nx));
+}
+
+bool Lattice::is_solid(std::size_t node) const {
+  if (solid_rows_.empty()) return false;
+  return solid_rows_[node / static_cast<std::size_t>(config_.nx)] != 0;
+}
+
+void Lattice::apply_interpolated_bounce_back(bool after_odd, int j0, int j1) {
+  if (wall_links_.empty() || !config_.interpolated_walls) return;
+  const int nx = config_.nx, ny = config_.ny;
+  double* f = f_.data();
+  const std::size_t S = stride_;
+  auto node = [&](int i, int j, int k) { return static_cast<std::size_t>(i) + static_cast<std::size_t>(nx) * (static_cast<std::size_t>(j) + static_cast<std::size_t>(ny) * static_cast<std::size_t>(k)); };
+  // Two phases: every new value from the step's populations first, then the writes, since a
+  // link's sources may be another link's target in a gap one node wide.
+  for (int phase = 0; phase < 2; ++phase) {
+    double* buf = wall_buffer_.data();
+    for (const WallLink& l : wall_links_) {
+      if (l.j < j0 || l.j >= j1) {
+        buf += nx;
+        continue;
+      }
+      const int q = l.q, qb = opposite(q);
+      const double t = l.fraction;
+      for (int i = 0; i < nx; ++i, ++buf) {
+        const std::size_t xf = node(i, l.j, l.k);
+        double& target = f[qb * S + xf];  // holds f*_q(x_f) after either step (plain bounce-back)
+        if (phase == 1) {
+          // The interpolation does not conserve mass (plain bounce-back does: it returns what went
+          // out); the rest population of the node takes back the difference, which keeps the
+          // node's momentum and the wall's order and stops the density drifting over a long run.
+          f[xf] -= *buf - target;
+          target = *buf;
+          continue;
+        }
+        const std::size_t xb = l.back_fluid ? node(wrap(i - kCx[q], nx), l.jb, l.kb) : xf;
+        if (t < 0.5) {
+          if (!l.back_fluid) {
+            *buf = target;
+            continue;
+          }
+          // f*_q(x_f - c_q): slot qbar of x_b after an even step, pushed into slot q of x_f by an odd one.
+          const double behind = after_odd ? f[q * S + xf] : f[qb * S + xb];
+          *buf = 2.0 * t * target + (1.0 - 2.0 * t) * behind;
+        } else {
+          // f*_qbar(x_f): slot q of x_f after an even step; pushed to slot qbar of x_b by an odd
+          // one (bounced into slot q of x_f when x_b is solid).
+          const double reverse = after_odd && l.back_fluid ? f[qb * S + xb] : f[q * S + xf];
+          *buf = target / (2.0 * t) + (2.0 * t - 1.0) / (2.0 * t) * reverse;
+        }
+      }
+    }
+  }
 }
 
 double Lattice::shear_rate() const { return config_.walls ? 2.0 * config_.wall_velocity / config_.nz : 0.0; }
@@ -447,14 +619,15 @@ void Lattice::initialise(const std::function<Vec3(const Vec3&)>& velocity,
     for (int j = 0; j < config_.ny; ++j) {
       for (int i = 0; i < config_.nx; ++i) {
         const Vec3 x = position(i, j, k);
-        const Vec3 u = velocity(x);
-        const double rho = density ? density(x) : 1.0;
+        const bool solid = solid_row(j, k);  // at rest, never stepped
+        const Vec3 u = solid ? Vec3::Zero() : velocity(x);
+        const double rho = density && !solid ? density(x) : 1.0;
         Mat3 S = Mat3::Zero();
-        if (stress) S = stress(x);
+        if (stress && !solid) S = stress(x);
         const std::size_t node = index(i, j, k);
         for (int q = 0; q < kQ; ++q) {
           double v = equilibrium(q, rho, u.x(), u.y(), u.z());
-          if (stress) {
+          if (stress && !solid) {
             const Vec3 c(kCx[q], kCy[q], kCz[q]);
             v -= 3.0 * tau * kW[q] * rho * (c.dot(S * c) - S.trace() / 3.0);
           }
@@ -493,7 +666,9 @@ void Lattice::set_uniform_force(const Vec3& F) {
 template <class Coll>
 void Lattice::step_with(const Coll& coll, int j0, int j1) {
   StepArgs a{f_.data(), stride_, config_.nx, config_.ny, config_.nz, j0, j1 - j0, config_.walls, step_ % 2 == 1,
-             config_.wall_velocity, {force_.data(), force_.data() + stride_, force_.data() + 2 * stride_}};
+             config_.wall_velocity, {force_.data(), force_.data() + stride_, force_.data() + 2 * stride_},
+             solid_rows_.empty() ? nullptr : solid_rows_.data(),
+             {config_.body_force.x(), config_.body_force.y(), config_.body_force.z()}};
   const int rows = (j1 - j0) * config_.nz;
   // Small lattices (tests) step on one thread: a parallel region costs more than their update.
 #pragma omp parallel if (n_ >= kParallelNodes)
@@ -503,6 +678,7 @@ void Lattice::step_with(const Coll& coll, int j0, int j1) {
     const int r1 = static_cast<int>(static_cast<std::int64_t>(rows) * (t + 1) / nt);
     process_rows(a, r0, r1, coll);
   }
+  apply_interpolated_bounce_back(a.odd, j0, j1);
   ++step_;
 }
 
@@ -516,6 +692,9 @@ void Lattice::step_layers(int j0, int j1) {
     step_with(Bgk<true>{1.0, 0.5}, j0, j1);
   } else if (collision_ == Collision::BGK) {
     step_with(Bgk<false>{1.0 / tau, 1.0 - 0.5 / tau}, j0, j1);
+  } else if (collision_ == Collision::TRT) {
+    // Lambda = (tau - 1/2)(1/omega- - 1/2).
+    step_with(Trt{1.0 / tau, 1.0 / (0.5 + config_.trt_magic / (tau - 0.5))}, j0, j1);
   } else {
     step_with(Regularized{1.0 - 1.0 / tau, 1.0 - 0.5 / tau}, j0, j1);
   }
@@ -534,7 +713,12 @@ void Lattice::populations(std::size_t node, double f[kQ]) const {
       const double uw = ks < 0 ? -config_.wall_velocity : config_.wall_velocity;
       f[q] = f_[q * stride_ + node] + 6.0 * kW[q] * kCx[q] * uw;
     } else {
-      const std::size_t src = index(wrap(i - kCx[q], config_.nx), wrap(j - kCy[q], config_.ny), wrap(ks, config_.nz));
+      const int js = wrap(j - kCy[q], config_.ny), kw = wrap(ks, config_.nz);
+      if (solid_row(js, kw)) {
+        f[q] = f_[q * stride_ + node];  // bounced back (and interpolated) after the even step
+        continue;
+      }
+      const std::size_t src = index(wrap(i - kCx[q], config_.nx), js, kw);
       f[q] = f_[opposite(q) * stride_ + src];
     }
   }
@@ -557,12 +741,14 @@ Vec3 Lattice::velocity(std::size_t node) const {
     rho += f[q];
     j += f[q] * Vec3(kCx[q], kCy[q], kCz[q]);
   }
-  return (j + 0.5 * force(node)) / rho;
+  return (j + 0.5 * (force(node) + config_.body_force)) / rho;
 }
 
 double Lattice::total_mass() const {
   double m = 0;
-  for (std::size_t node = 0; node < n_; ++node) m += density(node);
+  for (std::size_t node = 0; node < n_; ++node) {
+    if (!is_solid(node)) m += density(node);
+  }
   return m;
 }
 
@@ -570,6 +756,7 @@ Vec3 Lattice::total_momentum() const {
   Vec3 p = Vec3::Zero();
   double f[kQ];
   for (std::size_t node = 0; node < n_; ++node) {
+    if (is_solid(node)) continue;
     populations(node, f);
     for (int q = 0; q < kQ; ++q) p += f[q] * Vec3(kCx[q], kCy[q], kCz[q]);
   }

@@ -19,6 +19,27 @@
 //   f_i(x, t+1) = f_ibar*(x, t) + 6 w_i rho0 c_i.u_w   where x - c_i lies in the wall,
 // so the shear flow is u = gamma z e_x with gamma = 2 v / nz. Without walls z is periodic too.
 //
+// Channels and tubes (shared/spec/CELLS_IN_CHANNELS.md section 1). A uniform body force density g
+// (LatticeConfig::body_force, Guo forcing like the force field) drives the flow along x between
+// resting walls: the flat walls above with v = 0 (a slit channel), or a cross-section
+// (section_walls.hpp) whose solid rows along x the kernel skips and whose links into the solid are
+// bounced back for the whole row. Those links are then corrected to the wall's true position by
+// the linear interpolated bounce-back of Bouzidi, Firdaouss & Lallemand (2001): for a link from the
+// fluid node x_f along c_q meeting the wall at the fraction q of its length, the population
+// returning along -c_q is
+//   q <  1/2:  2 q f*_q(x_f) + (1 - 2 q) f*_q(x_f - c_q)
+//   q >= 1/2:  f*_q(x_f) / (2 q) + (2 q - 1) / (2 q) f*_qbar(x_f)
+// (f* post-collision; plain bounce-back where x_f - c_q is solid too). The interpolation does not
+// conserve mass, so the node's rest population takes back the difference to the plain bounce-back
+// (mass exactly conserved, momentum untouched). In the AA layout each of
+// these values sits in known slots once a step is complete, so a pass over the wall links after
+// every step rewrites the returning populations (apply_interpolated_bounce_back): the second
+// order of the wall survives without touching the kernel's rows.
+// Collision::TRT (two relaxation times, Ginzburg) relaxes the even part of each pair of opposite
+// populations with 1/tau and the odd part with omega_- from the magic parameter
+// Lambda = (tau - 1/2)(1/omega_- - 1/2) (3/16 by default), which puts a halfway bounce-back wall
+// of a Poiseuille flow exactly halfway at any tau.
+//
 // Memory layout: structure of arrays (population i of every node contiguous, x fastest) and a
 // single lattice updated with the AA pattern (Bailey et al. 2009): an even step reads the 19
 // populations of a node and writes the post-collision values back to the same node in the
@@ -35,11 +56,13 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <vector>
 
 #include "bendlab/core/aligned_allocator.hpp"
 #include "bendlab/core/types.hpp"
 #include "bendlab/flow/lbm/d3q19.hpp"
+#include "bendlab/flow/lbm/section_walls.hpp"
 
 namespace bendlab::lbm {
 
@@ -47,6 +70,7 @@ enum class Collision {
   Auto,         ///< BGK at tau == 1, Regularized otherwise
   BGK,          ///< BGK + Guo at any tau (ESPResSo's scheme only at tau = 1)
   Regularized,  ///< ESPResSo's MRT with default bulk/ghost relaxation, for any tau
+  TRT,          ///< two relaxation times with the magic parameter LatticeConfig::trt_magic, + Guo
 };
 
 struct LatticeConfig {
@@ -58,6 +82,17 @@ struct LatticeConfig {
   /// Pads the slots of the store (slot_stride()); false puts them num_nodes() apart, the plain
   /// layout kept as the reference the padded one is tested and benchmarked against.
   bool pad_slots = true;
+  /// Uniform body force density g (force per node), added to the force field in the collision
+  /// and in velocity(): it drives channel and tube flows without touching the sparse field the
+  /// immersed boundary writes.
+  Vec3 body_force = Vec3::Zero();
+  /// Lambda of Collision::TRT; 3/16 puts a plain bounce-back wall exactly halfway at any tau.
+  double trt_magic = 3.0 / 16.0;
+  /// Walls parallel to x (a tube); null: none. Rows whose centre it calls solid are not stepped.
+  std::shared_ptr<const SectionWalls> section;
+  /// false: the section's links keep the plain bounce-back (a staircase wall), the first-order
+  /// reference the interpolated one is measured against.
+  bool interpolated_walls = true;
 };
 
 class Lattice {
@@ -82,6 +117,13 @@ class Lattice {
   std::size_t index(int i, int j, int k) const {
     return static_cast<std::size_t>(i) + static_cast<std::size_t>(config_.nx) * (static_cast<std::size_t>(j) + static_cast<std::size_t>(config_.ny) * static_cast<std::size_t>(k));
   }
+  /// Whether node (j, k)'s row along x lies in the solid of config().section (never without one).
+  bool solid_row(int j, int k) const { return !solid_rows_.empty() && solid_rows_[static_cast<std::size_t>(j) + static_cast<std::size_t>(config_.ny) * static_cast<std::size_t>(k)] != 0; }
+  bool is_solid(std::size_t node) const;
+  /// Nodes in the fluid (num_nodes() less the solid rows).
+  std::size_t num_fluid_nodes() const { return fluid_nodes_; }
+  /// Links from a fluid row into a solid row (each counted once per row, not per node).
+  std::size_t num_wall_links() const { return wall_links_.size(); }
   /// (i, j, k) of a node index.
   std::array<int, 3> coordinates(std::size_t node) const;
   /// Physical position of node (i, j, k) (box centred on the origin).
@@ -134,7 +176,7 @@ class Lattice {
   double density(std::size_t node) const;
   /// u = (sum f c + F/2) / rho with the current force field.
   Vec3 velocity(std::size_t node) const;
-  /// Sum of rho, and of sum f c (without F/2), over all nodes.
+  /// Sum of rho, and of sum f c (without F/2), over all fluid nodes.
   double total_mass() const;
   Vec3 total_momentum() const;
 
@@ -154,6 +196,10 @@ class Lattice {
  private:
   template <class Coll>
   void step_with(const Coll& coll, int j0, int j1);
+  void build_section();
+  /// The interpolated bounce-back pass after a step (header comment); `after_odd` tells where the
+  /// step left its populations.
+  void apply_interpolated_bounce_back(bool after_odd, int j0, int j1);
 
   LatticeConfig config_;
   Collision collision_;
@@ -167,6 +213,18 @@ class Lattice {
   // list would exceed num_nodes() / 8 or after set_uniform_force.
   std::vector<std::size_t> forced_;
   bool force_everywhere_ = false;
+  // The cross-section: solid flag per row (j + ny k), empty without one, and the links of fluid
+  // rows into solid rows with the wall fraction q and whether the row behind (x_f - c_q) is fluid.
+  struct WallLink {
+    int j, k, q;
+    double fraction;
+    bool back_fluid;
+    int jb, kb;  // the row of x_f - c_q (periodic wrap)
+  };
+  std::vector<std::uint8_t> solid_rows_;
+  std::vector<WallLink> wall_links_;
+  std::vector<double> wall_buffer_;
+  std::size_t fluid_nodes_ = 0;
   void note_forced(std::size_t node) {
     if (force_everywhere_) return;
     if (forced_.size() >= n_ / 8) {

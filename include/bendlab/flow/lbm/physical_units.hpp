@@ -1,0 +1,84 @@
+#pragma once
+// Physical units at the interface of a channel or tube run, lattice units inside
+// (shared/spec/CELLS_IN_CHANNELS.md section 1; docs/conventions.md §6).
+//
+// The user gives the lattice spacing dx (um), the relaxation time tau, the plasma (viscosity eta,
+// density rho), the geometry in um and the driving, either as the pseudo-shear rate v / D (tube)
+// or v / H (slit channel) of the cell-free flow, v its mean velocity (Pries' measure, 1/s), or as
+// the body force density g (N/m^3). The other follows from Poiseuille's law,
+//   tube:    v = g D^2 / (32 eta),      u_max = 2 v
+//   channel: v = g H^2 / (12 eta),      u_max = 3/2 v   (slit: plane walls at z = -+H/2),
+// and the lattice units from
+//   nu = eta / rho,  nu_lattice = (tau - 1/2) / 3,  dt = nu_lattice dx^2 / nu,
+//   g_lattice = g dt^2 / (rho dx),  u_lattice = u dt / dx,
+// Mach number Ma = sqrt(3) u_max,lattice, Reynolds number Re = v D / nu (or v H / nu).
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "bendlab/flow/lbm/lattice.hpp"
+
+namespace bendlab::lbm {
+
+enum class FlowGeometry { Tube, Channel };
+
+/// "tube", "channel".
+std::string to_string(FlowGeometry geometry);
+
+/// Blood plasma at 37 C (docs/conventions.md §6: eta = 1.2 mPa s, rho = 1025 kg/m^3).
+struct Plasma {
+  double viscosity = 1.2e-3;  ///< eta, Pa s
+  double density = 1025.0;    ///< rho, kg/m^3
+};
+
+struct FlowUnitsInput {
+  FlowGeometry geometry = FlowGeometry::Tube;
+  double diameter_um = 0;  ///< tube
+  double height_um = 0;    ///< channel: wall distance (z)
+  double width_um = 0;     ///< channel: periodic extent across the flow (y)
+  double length_um = 0;    ///< periodic extent along the flow (x)
+  double dx_um = 0.5;
+  double tau = 1.0;
+  Plasma plasma;
+  std::optional<double> pseudo_shear_rate;  ///< v / D or v / H, 1/s
+  std::optional<double> body_force;         ///< g, N/m^3
+  double max_mach = 0.1;                    ///< refused above this
+};
+
+struct FlowUnits {
+  FlowUnitsInput input;
+  int nx = 0, ny = 0, nz = 0;     ///< lattice nodes (the tube's box adds one solid layer around it)
+  double dt = 0;                  ///< s per step
+  double nu = 0, nu_lattice = 0;  ///< m^2/s, dx^2/dt
+  double body_force = 0;          ///< g, N/m^3
+  double body_force_lattice = 0;
+  double pseudo_shear_rate = 0;   ///< 1/s
+  double mean_velocity = 0;       ///< v of the cell-free flow, m/s
+  double max_velocity_lattice = 0;
+  double mach = 0, reynolds = 0;
+  /// The section's size in dx: D / dx (tube) or H / dx (channel).
+  double section_lattice = 0;
+
+  double dx() const { return input.dx_um * 1e-6; }
+  /// Seconds of `steps` lattice steps, and the steps (rounded up) to reach `seconds`.
+  double seconds(double steps) const { return steps * dt; }
+  double steps_for(double seconds) const;
+  /// Lattice velocity of a physical one (m/s) and back.
+  double to_lattice_velocity(double u) const { return u * dt / dx(); }
+  double to_physical_velocity(double u_lattice) const { return u_lattice * dx() / dt; }
+  /// The lines a run prints about the units it chose.
+  std::vector<std::string> describe() const;
+};
+
+/// Validates and converts. Throws bendlab::Error, naming the option, for: a non-positive or
+/// non-finite size, dx, viscosity or density; tau <= 1/2; a channel height, width or length, or a
+/// tube length, that is not a whole number of dx (within 1e-6 dx); a tube diameter below 4 dx;
+/// neither or both drivings, or a negative one; and a Mach number above max_mach.
+FlowUnits flow_units(const FlowUnitsInput& input);
+
+/// The lattice of these units: TRT (walls exactly placed at any tau), the body force along x,
+/// and either the tube's cross-section (TubeWall of radius D / (2 dx), interpolated bounce-back)
+/// or the channel's flat resting walls at z = -+H/2, periodic in x and y.
+LatticeConfig flow_lattice_config(const FlowUnits& units);
+
+}  // namespace bendlab::lbm

@@ -1,0 +1,134 @@
+#include "bendlab/flow/lbm/physical_units.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <memory>
+
+#include "bendlab/core/types.hpp"
+
+namespace bendlab::lbm {
+
+namespace {
+
+void require_positive(double v, const char* what) {
+  if (!(v > 0) || !std::isfinite(v)) throw Error(fmt::format("{} {} must be finite and positive", what, v));
+}
+
+// A size that must be a whole number of dx: its count of dx.
+int whole_cells(double size_um, double dx_um, const char* option) {
+  const double n = size_um / dx_um;
+  const double r = std::round(n);
+  if (std::abs(n - r) > 1e-6 || r < 1) {
+    throw Error(fmt::format("{} {} um is not a whole number of dx = {} um ({} dx)", option, size_um, dx_um, n));
+  }
+  if (r > 1e6) throw Error(fmt::format("{} {} um is {} dx: too many lattice nodes", option, size_um, r));
+  return static_cast<int>(r);
+}
+
+}  // namespace
+
+std::string to_string(FlowGeometry geometry) { return geometry == FlowGeometry::Tube ? "tube" : "channel"; }
+
+double FlowUnits::steps_for(double s) const { return std::ceil(s / dt - 1e-9); }
+
+FlowUnits flow_units(const FlowUnitsInput& in) {
+  FlowUnits u;
+  u.input = in;
+  require_positive(in.dx_um, "--dx");
+  require_positive(in.plasma.viscosity, "plasma viscosity");
+  require_positive(in.plasma.density, "plasma density");
+  if (!(in.tau > 0.5) || !std::isfinite(in.tau)) {
+    throw Error(fmt::format("--tau {} must exceed 1/2 (the lattice viscosity (tau - 1/2)/3 must be positive)", in.tau));
+  }
+  require_positive(in.max_mach, "maximum Mach number");
+  if (in.pseudo_shear_rate.has_value() == in.body_force.has_value()) {
+    throw Error("give the driving either as --pseudo-shear-rate (1/s) or as --body-force (N/m^3), one of them");
+  }
+  if (in.pseudo_shear_rate && (!(*in.pseudo_shear_rate >= 0) || !std::isfinite(*in.pseudo_shear_rate))) {
+    throw Error(fmt::format("--pseudo-shear-rate {} must be finite and not negative", *in.pseudo_shear_rate));
+  }
+  if (in.body_force && (!(*in.body_force >= 0) || !std::isfinite(*in.body_force))) {
+    throw Error(fmt::format("--body-force {} must be finite and not negative", *in.body_force));
+  }
+  require_positive(in.length_um, "--length");
+  u.nx = whole_cells(in.length_um, in.dx_um, "--length");
+  const double eta = in.plasma.viscosity, dx = in.dx_um * 1e-6;
+  double section = 0;  // D or H in m
+  if (in.geometry == FlowGeometry::Tube) {
+    require_positive(in.diameter_um, "--diameter");
+    section = in.diameter_um * 1e-6;
+    u.section_lattice = in.diameter_um / in.dx_um;
+    if (u.section_lattice < 4) {
+      throw Error(fmt::format("--diameter {} um is {} dx: a tube needs at least 4 dx across", in.diameter_um, u.section_lattice));
+    }
+    if (u.section_lattice > 1e5) throw Error(fmt::format("--diameter {} um is {} dx: too many lattice nodes", in.diameter_um, u.section_lattice));
+    // One solid row at least on every side, so that every wall link ends in the solid.
+    u.ny = u.nz = static_cast<int>(std::ceil(u.section_lattice - 1e-9)) + 2;
+  } else {
+    require_positive(in.height_um, "--height");
+    require_positive(in.width_um, "--width");
+    u.nz = whole_cells(in.height_um, in.dx_um, "--height");
+    u.ny = whole_cells(in.width_um, in.dx_um, "--width");
+    if (u.nz < 4) throw Error(fmt::format("--height {} um is {} dx: a channel needs at least 4 dx across", in.height_um, u.nz));
+    section = in.height_um * 1e-6;
+    u.section_lattice = u.nz;
+  }
+  u.nu = eta / in.plasma.density;
+  u.nu_lattice = (in.tau - 0.5) / 3.0;
+  u.dt = u.nu_lattice * dx * dx / u.nu;
+  const double shape = in.geometry == FlowGeometry::Tube ? 32.0 : 12.0;  // v = g S^2 / (shape eta)
+  if (in.pseudo_shear_rate) {
+    u.pseudo_shear_rate = *in.pseudo_shear_rate;
+    u.mean_velocity = u.pseudo_shear_rate * section;
+    u.body_force = shape * eta * u.mean_velocity / (section * section);
+  } else {
+    u.body_force = *in.body_force;
+    u.mean_velocity = u.body_force * section * section / (shape * eta);
+    u.pseudo_shear_rate = u.mean_velocity / section;
+  }
+  u.body_force_lattice = u.body_force * u.dt * u.dt / (in.plasma.density * dx);
+  const double peak = in.geometry == FlowGeometry::Tube ? 2.0 : 1.5;
+  u.max_velocity_lattice = peak * u.to_lattice_velocity(u.mean_velocity);
+  u.mach = std::sqrt(3.0) * u.max_velocity_lattice;
+  u.reynolds = u.mean_velocity * section / u.nu;
+  if (!(u.mach <= in.max_mach)) {
+    throw Error(fmt::format("Mach number {:.3g} (peak lattice velocity {:.3g}) exceeds {}: lower the driving, dx or tau",
+                            u.mach, u.max_velocity_lattice, in.max_mach));
+  }
+  return u;
+}
+
+std::vector<std::string> FlowUnits::describe() const {
+  const bool tube = input.geometry == FlowGeometry::Tube;
+  std::vector<std::string> lines;
+  lines.push_back(fmt::format("{} {} um across ({:.4g} dx), {} um long; lattice {} x {} x {} nodes, dx = {} um",
+                              to_string(input.geometry), tube ? input.diameter_um : input.height_um, section_lattice,
+                              input.length_um, nx, ny, nz, input.dx_um));
+  lines.push_back(fmt::format("plasma eta = {} Pa s, rho = {} kg/m^3 (nu = {:.4g} m^2/s); tau = {} (nu = {:.4g} dx^2/dt): dt = {:.4g} s",
+                              input.plasma.viscosity, input.plasma.density, nu, input.tau, nu_lattice, dt));
+  lines.push_back(fmt::format("driving: pseudo-shear rate {:.4g} 1/s, body force {:.4g} N/m^3 ({:.4g} lattice), mean velocity {:.4g} um/s",
+                              pseudo_shear_rate, body_force, body_force_lattice, mean_velocity * 1e6));
+  lines.push_back(fmt::format("peak lattice velocity {:.4g}, Mach {:.3g}, Reynolds {:.3g}", max_velocity_lattice, mach, reynolds));
+  return lines;
+}
+
+LatticeConfig flow_lattice_config(const FlowUnits& u) {
+  LatticeConfig c;
+  c.nx = u.nx;
+  c.ny = u.ny;
+  c.nz = u.nz;
+  c.tau = u.input.tau;
+  c.collision = Collision::TRT;
+  c.body_force = Vec3(u.body_force_lattice, 0, 0);
+  if (u.input.geometry == FlowGeometry::Tube) {
+    c.walls = false;
+    c.section = std::make_shared<TubeWall>(0.5 * u.section_lattice);
+  } else {
+    c.walls = true;
+    c.wall_velocity = 0;
+  }
+  return c;
+}
+
+}  // namespace bendlab::lbm
