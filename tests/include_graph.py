@@ -2,7 +2,7 @@
 """Checks the layering of bendlab: every `#include "bendlab/<folder>/..."` in include/, src/ and
 apps/ must go to a folder that the including file's folder may depend on (docs/design.md, Layout).
 
-    core <- mesh <- geometry <- bending <- elasticity/membrane <- capsule <- flow <- analysis <- apps
+    core <- mesh <- geometry <- bending <- elasticity/membrane <- suspension <- capsule <- flow <- analysis <- apps
     parallel (MPI, optional) sits on flow, beside analysis; only apps include it.
     surfaces depends on core and mesh only; integrate on core, mesh and geometry.
 
@@ -25,15 +25,19 @@ ALLOWED = {
     "elasticity": {"core", "mesh", "geometry"},
     "integrate": {"core", "mesh", "geometry"},
     "membrane": {"core", "mesh", "geometry", "bending", "elasticity"},
-    "capsule": {"core", "mesh", "geometry", "surfaces", "bending", "elasticity", "membrane", "integrate"},
-    "flow": {"core", "mesh", "geometry", "surfaces", "bending", "elasticity", "membrane", "integrate", "capsule"},
+    # Many cells: vessels, contact forces, placement (no flow solver).
+    "suspension": {"core", "mesh", "geometry", "surfaces", "bending", "elasticity", "membrane"},
+    "capsule": {"core", "mesh", "geometry", "surfaces", "bending", "elasticity", "membrane", "integrate",
+                "suspension"},
+    "flow": {"core", "mesh", "geometry", "surfaces", "bending", "elasticity", "membrane", "integrate",
+             "suspension", "capsule"},
     "analysis": {"core", "mesh", "geometry", "surfaces", "bending", "elasticity", "membrane", "integrate",
-                 "capsule", "flow"},
+                 "suspension", "capsule", "flow"},
     # MPI domain decomposition of flow/lbm (built only with BENDLAB_MPI; nothing below includes it).
     "parallel": {"core", "mesh", "geometry", "surfaces", "bending", "elasticity", "membrane", "integrate",
-                 "capsule", "flow"},
+                 "suspension", "capsule", "flow"},
     "apps": {"core", "mesh", "geometry", "surfaces", "bending", "elasticity", "membrane", "integrate",
-             "capsule", "flow", "analysis", "parallel"},
+             "suspension", "capsule", "flow", "analysis", "parallel"},
 }
 
 INCLUDE = re.compile(r'^\s*#\s*include\s*"bendlab/([^/"]+)/[^"]*"', re.MULTILINE)

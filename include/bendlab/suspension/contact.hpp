@@ -1,0 +1,57 @@
+#pragma once
+// Short-range repulsion between the membranes of different cells and between a membrane and the
+// vessel's wall (shared/spec/CELLS_IN_CHANNELS.md section 2; docs/conventions.md §6): without it
+// cells cross walls and each other where the immersed boundary lets fluid leak between them.
+//
+// The law acts between vertices of different cells (and between a vertex and the wall) at a
+// distance r below the cutoff r_c:
+//   U(r) = F_max r_c / 3 (1 - r/r_c)^3,     F(r) = -dU/dr = F_max (1 - r/r_c)^2,
+// repulsive, capped at F_max (r -> 0), zero with a zero slope at r_c and exactly zero beyond, so
+// cells farther apart than r_c feel nothing and the force switches on smoothly. A vertex past the
+// wall (r < 0) feels F_max towards the fluid. Vertices of one cell never repel each other: the
+// membrane's own elasticity keeps its shape.
+//
+// Pairs are found with a uniform cell list of bins at least r_c wide; separations take the
+// nearest periodic image (Vessel::minimum_image), so positions may be unwrapped. ContactSearch
+// keeps its bins between calls: once warm it allocates nothing.
+#include <vector>
+
+#include "bendlab/core/types.hpp"
+#include "bendlab/suspension/vessel.hpp"
+
+namespace bendlab {
+
+struct ContactLaw {
+  double max_force = 0;  ///< F_max, the force at contact
+  double cutoff = 0;     ///< r_c
+  /// Throws bendlab::Error for a negative or non-finite force or a non-positive cutoff.
+  void validate() const;
+  double force(double r) const;
+  double energy(double r) const;
+};
+
+/// Adds the wall's repulsion on every vertex of x to F; returns the energy sum_i U(d_i).
+double add_wall_contact(const Vessel& vessel, const ContactLaw& law, const Points& x, Points& F);
+
+class ContactSearch {
+ public:
+  /// Adds the repulsion between vertices of different cells (cell_of[i]: the cell of row i of x)
+  /// to F; returns the energy summed over the pairs.
+  double add_cell_contact(const Vessel& vessel, const ContactLaw& law, const Points& x,
+                          const std::vector<int>& cell_of, Points& F);
+  /// The smallest distance between vertices of different cells closer than `range` (range if
+  /// none): a diagnostic of how near the cells came.
+  double min_cell_distance(const Vessel& vessel, const Points& x, const std::vector<int>& cell_of, double range);
+
+ private:
+  // Bins the rows of x (bins at least `width` wide); the pairs then come from bin_pairs.
+  void bin(const Vessel& vessel, const Points& x, double width);
+  template <class Visit>
+  void for_each_pair(const Vessel& vessel, const Points& x, const std::vector<int>& cell_of, double range, Visit&& visit);
+
+  int nb_[3] = {0, 0, 0};
+  double lo_[3] = {0, 0, 0}, w_[3] = {1, 1, 1};
+  std::vector<int> bin_of_, start_, items_;
+};
+
+}  // namespace bendlab

@@ -1,0 +1,138 @@
+#include "bendlab/suspension/contact.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace bendlab {
+
+void ContactLaw::validate() const {
+  if (!(max_force >= 0) || !std::isfinite(max_force)) throw Error(fmt::format("contact force {} must be finite and not negative", max_force));
+  if (!(cutoff > 0) || !std::isfinite(cutoff)) throw Error(fmt::format("contact cutoff {} must be finite and positive", cutoff));
+}
+
+double ContactLaw::force(double r) const {
+  if (r >= cutoff) return 0.0;
+  const double s = 1.0 - std::max(r, 0.0) / cutoff;
+  return max_force * s * s;
+}
+
+double ContactLaw::energy(double r) const {
+  if (r >= cutoff) return 0.0;
+  const double s = 1.0 - r / cutoff;  // past the wall (r < 0) the energy keeps growing, the force stays capped
+  return r >= 0 ? max_force * cutoff / 3.0 * s * s * s : max_force * cutoff / 3.0 - max_force * r;
+}
+
+double add_wall_contact(const Vessel& vessel, const ContactLaw& law, const Points& x, Points& F) {
+  double energy = 0;
+  for (Eigen::Index i = 0; i < x.rows(); ++i) {
+    const Vec3 p = row(x, i);
+    const double d = vessel.wall_distance(p);
+    if (d >= law.cutoff) continue;
+    F.row(i) += law.force(d) * vessel.wall_normal(p).transpose();
+    energy += law.energy(d);
+  }
+  return energy;
+}
+
+void ContactSearch::bin(const Vessel& vessel, const Points& x, double width) {
+  const Eigen::Index n = x.rows();
+  const Vec3 period = vessel.period();
+  for (int a = 0; a < 3; ++a) {
+    if (vessel.periodic(a)) {
+      nb_[a] = std::max(1, static_cast<int>(std::floor(period[a] / width)));
+      lo_[a] = -0.5 * period[a];
+      w_[a] = period[a] / nb_[a];
+    } else {
+      const double lo = n > 0 ? x.col(a).minCoeff() : 0.0, hi = n > 0 ? x.col(a).maxCoeff() : 0.0;
+      nb_[a] = std::max(1, std::min(1 << 20, static_cast<int>(std::floor((hi - lo) / width))));
+      lo_[a] = lo;
+      w_[a] = std::max((hi - lo) / nb_[a], width);
+    }
+  }
+  const std::size_t bins = static_cast<std::size_t>(nb_[0]) * nb_[1] * nb_[2];
+  bin_of_.resize(n);
+  start_.assign(bins + 1, 0);
+  items_.resize(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    int b[3];
+    for (int a = 0; a < 3; ++a) {
+      double c = x(i, a);
+      if (vessel.periodic(a)) c -= period[a] * std::floor((c - lo_[a]) / period[a]);  // into [lo, lo + period)
+      b[a] = std::clamp(static_cast<int>(std::floor((c - lo_[a]) / w_[a])), 0, nb_[a] - 1);
+    }
+    bin_of_[i] = b[0] + nb_[0] * (b[1] + nb_[1] * b[2]);
+    ++start_[bin_of_[i] + 1];
+  }
+  for (std::size_t b = 0; b < bins; ++b) start_[b + 1] += start_[b];
+  // Counting sort; start_ is shifted back afterwards.
+  for (Eigen::Index i = 0; i < n; ++i) items_[start_[bin_of_[i]]++] = static_cast<int>(i);
+  for (std::size_t b = bins; b > 0; --b) start_[b] = start_[b - 1];
+  start_[0] = 0;
+}
+
+template <class Visit>
+void ContactSearch::for_each_pair(const Vessel& vessel, const Points& x, const std::vector<int>& cell_of, double range,
+                                  Visit&& visit) {
+  if (static_cast<Eigen::Index>(cell_of.size()) != x.rows()) {
+    throw Error(fmt::format("contact search: {} cell indices for {} vertices", cell_of.size(), x.rows()));
+  }
+  bin(vessel, x, range);
+  const double r2max = range * range;
+  for (Eigen::Index i = 0; i < x.rows(); ++i) {
+    const int b = bin_of_[i];
+    const int bx = b % nb_[0], by = (b / nb_[0]) % nb_[1], bz = b / (nb_[0] * nb_[1]);
+    const int home[3] = {bx, by, bz};
+    // The distinct neighbour bins along each axis (fewer than 3 when the axis has fewer bins).
+    int nbrs[3][3], count[3];
+    for (int a = 0; a < 3; ++a) {
+      count[a] = 0;
+      for (int o = -1; o <= 1; ++o) {
+        int c = home[a] + o;
+        if (vessel.periodic(a)) {
+          c = (c % nb_[a] + nb_[a]) % nb_[a];
+        } else if (c < 0 || c >= nb_[a]) {
+          continue;
+        }
+        if (std::find(nbrs[a], nbrs[a] + count[a], c) == nbrs[a] + count[a]) nbrs[a][count[a]++] = c;
+      }
+    }
+    const Vec3 xi = row(x, i);
+    for (int iz = 0; iz < count[2]; ++iz) {
+      for (int iy = 0; iy < count[1]; ++iy) {
+        for (int ix = 0; ix < count[0]; ++ix) {
+          const int nb = nbrs[0][ix] + nb_[0] * (nbrs[1][iy] + nb_[1] * nbrs[2][iz]);
+          for (int s = start_[nb]; s < start_[nb + 1]; ++s) {
+            const int j = items_[s];
+            if (j <= i || cell_of[j] == cell_of[i]) continue;
+            const Vec3 d = vessel.minimum_image(xi - row(x, j));
+            const double r2 = d.squaredNorm();
+            if (r2 < r2max) visit(static_cast<int>(i), j, d, std::sqrt(r2));
+          }
+        }
+      }
+    }
+  }
+}
+
+double ContactSearch::add_cell_contact(const Vessel& vessel, const ContactLaw& law, const Points& x,
+                                       const std::vector<int>& cell_of, Points& F) {
+  double energy = 0;
+  for_each_pair(vessel, x, cell_of, law.cutoff, [&](int i, int j, const Vec3& d, double r) {
+    energy += law.energy(r);
+    if (r == 0) return;  // no direction: the neighbours' pushes separate the two
+    const Vec3 f = law.force(r) / r * d;
+    F.row(i) += f.transpose();
+    F.row(j) -= f.transpose();
+  });
+  return energy;
+}
+
+double ContactSearch::min_cell_distance(const Vessel& vessel, const Points& x, const std::vector<int>& cell_of, double range) {
+  double m = range;
+  for_each_pair(vessel, x, cell_of, range, [&](int, int, const Vec3&, double r) { m = std::min(m, r); });
+  return m;
+}
+
+}  // namespace bendlab

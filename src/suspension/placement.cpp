@@ -1,0 +1,199 @@
+#include "bendlab/suspension/placement.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <random>
+
+#include "bendlab/geometry/point_in_mesh.hpp"
+#include "bendlab/mesh/enclosed_volume.hpp"
+
+namespace bendlab {
+
+namespace {
+
+// Shoemake's uniform random rotation.
+Mat3 random_rotation(std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const double u1 = u(rng), u2 = 2 * std::numbers::pi * u(rng), u3 = 2 * std::numbers::pi * u(rng);
+  const Eigen::Quaterniond q(std::sqrt(u1) * std::cos(u3), std::sqrt(1 - u1) * std::sin(u2), std::sqrt(1 - u1) * std::cos(u2),
+                             std::sqrt(u1) * std::sin(u3));
+  return q.normalized().toRotationMatrix();
+}
+
+// The reference z axis turned onto x, spun about it and tilted by up to `max_tilt`.
+Mat3 aligned_rotation(std::mt19937_64& rng, double max_tilt) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const Eigen::AngleAxisd spin(2 * std::numbers::pi * u(rng), Vec3::UnitZ());
+  const Eigen::AngleAxisd onto_x(0.5 * std::numbers::pi, Vec3::UnitY());  // z -> x
+  const double tilt = max_tilt * u(rng), about = 2 * std::numbers::pi * u(rng);
+  const Eigen::AngleAxisd tilted(tilt, Vec3(0, std::cos(about), std::sin(about)));
+  return (tilted * onto_x * spin).toRotationMatrix();
+}
+
+// The middle of the widest gap between the cells' centres along the periodic x axis (the whole
+// period when there are none).
+double widest_gap_middle(const std::vector<double>& xs, double length, double& gap) {
+  if (xs.empty()) {
+    gap = length;
+    return 0;
+  }
+  std::vector<double> sorted;
+  for (double x : xs) sorted.push_back(x - length * std::floor(x / length + 0.5));  // into [-L/2, L/2)
+  std::sort(sorted.begin(), sorted.end());
+  gap = -1;
+  double middle = 0;
+  for (std::size_t i = 0; i < sorted.size(); ++i) {
+    const double next = i + 1 < sorted.size() ? sorted[i + 1] : sorted[0] + length;
+    if (next - sorted[i] > gap) {
+      gap = next - sorted[i];
+      middle = 0.5 * (sorted[i] + next);
+    }
+  }
+  return middle;
+}
+
+struct Candidate {
+  Points x;
+  BoundingBox box;
+  Vec3 centre;
+};
+
+bool clear_of_wall(const Vessel& v, const Points& x, double clearance) {
+  for (Eigen::Index i = 0; i < x.rows(); ++i) {
+    if (v.wall_distance(row(x, i)) < clearance) return false;
+  }
+  return true;
+}
+
+// Whether cells a and b (b shifted by `shift`, a periodic image) keep the clearance and neither
+// holds a vertex of the other.
+bool apart(const Topology& topo, const Candidate& a, const Candidate& b, const Vec3& shift, double clearance) {
+  Points bx = b.x;
+  bx.rowwise() += shift.transpose();
+  BoundingBox bb{b.box.lo + shift, b.box.hi + shift};
+  // Boxes farther apart than the clearance: nothing to check.
+  if (((a.box.lo.array() - bb.hi.array()) >= clearance).any() || ((bb.lo.array() - a.box.hi.array()) >= clearance).any()) return true;
+  const double c2 = clearance * clearance;
+  for (Eigen::Index i = 0; i < a.x.rows(); ++i) {
+    const Vec3 p = row(a.x, i);
+    if (!bb.contains(p, clearance)) continue;
+    for (Eigen::Index j = 0; j < bx.rows(); ++j) {
+      if ((p - row(bx, j)).squaredNorm() < c2) return false;
+    }
+    if (contains(topo, bx, bb, p)) return false;
+  }
+  for (Eigen::Index j = 0; j < bx.rows(); ++j) {
+    if (contains(topo, a.x, a.box, row(bx, j))) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+Points placed_positions(const Points& reference, const PlacedCell& cell) {
+  Points x = reference * cell.rotation.transpose();
+  x.rowwise() += cell.centre.transpose();
+  return x;
+}
+
+Placement place_cells(const Vessel& vessel, const Topology& topo, const Points& reference, const PlacementOptions& o) {
+  if (o.hematocrit.has_value() == o.count.has_value()) throw Error("cell placement: give either a hematocrit or a number of cells");
+  if (!(o.clearance >= 0) || !std::isfinite(o.clearance)) throw Error(fmt::format("cell placement: clearance {} must be finite and not negative", o.clearance));
+  if (o.attempts_per_cell < 1) throw Error("cell placement: at least one attempt per cell");
+  Placement result;
+  result.cell_volume = enclosed_volume(topo, reference);
+  if (!(result.cell_volume > 0)) throw Error("cell placement: the cell's volume is not positive");
+  int target = 0;
+  if (o.hematocrit) {
+    const double h = *o.hematocrit;
+    if (!(h >= 0) || !std::isfinite(h) || h >= 1) throw Error(fmt::format("--hematocrit {} must lie in [0, 1)", h));
+    target = static_cast<int>(std::lround(h * vessel.volume() / result.cell_volume));
+    if (h > 0 && target == 0) {
+      throw Error(fmt::format("--hematocrit {} is less than one cell in the {} (one cell is {:.3g})", h, vessel.describe(),
+                              result.cell_volume / vessel.volume()));
+    }
+  } else {
+    if (*o.count < 0) throw Error(fmt::format("--cells {} must not be negative", *o.count));
+    target = *o.count;
+  }
+  double extent = 0;
+  for (Eigen::Index i = 0; i < reference.rows(); ++i) extent = std::max(extent, reference.row(i).norm());
+  const double half_width = vessel.kind() == VesselKind::Tube ? 0.5 * vessel.diameter() : 0.5 * vessel.height();
+  std::mt19937_64 rng(o.seed);
+  std::uniform_real_distribution<double> u(-0.5, 0.5);
+  std::vector<Candidate> placed;
+  placed.reserve(target);
+  std::vector<double> centres_x;
+  // A tube less than two cell diameters across holds its cells stacked along the axis, as red
+  // blood cells go through capillaries: every attempt aligns the cell with the flow.
+  const bool narrow = vessel.kind() == VesselKind::Tube && half_width < 2 * extent;
+  const double x0 = u(rng) * vessel.length();
+  const Vec3 period = vessel.period();
+  for (int c = 0; c < target; ++c) {
+    bool ok = false;
+    for (int attempt = 0; attempt < o.attempts_per_cell && !ok; ++attempt) {
+      ++result.attempts;
+      const bool aligned = narrow || attempt >= o.attempts_per_cell / 2;
+      // In a narrow tube the tilt and the jitter shrink as the attempts go by, down to a cell
+      // square to the axis in the middle of its slot.
+      const double freedom = narrow ? 1.0 - static_cast<double>(attempt) / o.attempts_per_cell : 1.0;
+      const Mat3 R = aligned ? aligned_rotation(rng, freedom * std::numbers::pi / 6) : random_rotation(rng);
+      Vec3 centre(u(rng) * vessel.length(), u(rng) * vessel.width(), u(rng) * vessel.height());
+      if (narrow) {
+        // Stacked along the tube in equal slots from a random start.
+        const double slot = vessel.length() / target;
+        centre.x() = x0 + (c + 0.5) * slot + freedom * 0.5 * slot * u(rng);
+      } else if (aligned && vessel.kind() == VesselKind::Tube) {
+        // Into the widest gap between the cells placed along the tube, jittered.
+        double gap = 0;
+        centre.x() = widest_gap_middle(centres_x, vessel.length(), gap) + 0.25 * gap * u(rng);
+      }
+      if (vessel.kind() == VesselKind::Tube || aligned) {
+        // Uniform in the disc (tube) or slab (others) left by the wall; aligned cells near the axis.
+        const double reach = std::max(half_width - (aligned ? 0.8 * half_width : 0.0), 0.0) * (narrow ? freedom : 1.0);
+        if (vessel.kind() == VesselKind::Tube) {
+          const double r = reach * std::sqrt(u(rng) + 0.5), phi = 2 * std::numbers::pi * u(rng);
+          centre.y() = r * std::cos(phi);
+          centre.z() = r * std::sin(phi);
+        } else {
+          centre.z() = 2 * reach * u(rng);
+        }
+      }
+      Candidate cand{placed_positions(reference, PlacedCell{R, centre}), {}, centre};
+      if (!clear_of_wall(vessel, cand.x, o.clearance)) continue;
+      cand.box = bounding_box(cand.x);
+      ok = true;
+      for (const Candidate& other : placed) {
+        // The nearest image of the other cell, and its neighbours along the periodic axes when the
+        // cells are large against the period.
+        const Vec3 d = vessel.minimum_image(other.centre - cand.centre) - (other.centre - cand.centre);
+        for (int sx = -1; sx <= 1 && ok; ++sx) {
+          for (int sy = vessel.periodic(1) ? -1 : 0; sy <= (vessel.periodic(1) ? 1 : 0) && ok; ++sy) {
+            const Vec3 shift = d + Vec3(sx * period.x(), sy * period.y(), 0);
+            if ((other.centre + shift - cand.centre).norm() > 2 * extent + o.clearance) continue;
+            ok = apart(topo, cand, other, shift, o.clearance);
+          }
+        }
+        if (!ok) break;
+      }
+      if (ok) {
+        placed.push_back(std::move(cand));
+        result.cells.push_back(PlacedCell{R, centre});
+        centres_x.push_back(centre.x());
+      }
+    }
+    if (!ok) {
+      const double best = static_cast<double>(placed.size()) * result.cell_volume / vessel.volume();
+      throw Error(fmt::format("cannot place {} cells (H_T {:.4f}) in the {}: {} placed (H_T {:.4f}) before cell {} failed {} attempts",
+                              target, target * result.cell_volume / vessel.volume(), vessel.describe(), placed.size(), best,
+                              c + 1, o.attempts_per_cell));
+    }
+  }
+  result.hematocrit = static_cast<double>(result.cells.size()) * result.cell_volume / vessel.volume();
+  return result;
+}
+
+}  // namespace bendlab

@@ -1,0 +1,176 @@
+// Contact forces between cells and with the wall (contact.hpp): the law's shape, forces as the
+// exact negative gradient of the energy, Newton's third law, and the cell list against the plain
+// all-pairs reference with nearest periodic images.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "bendlab/suspension/contact.hpp"
+
+using namespace bendlab;
+
+namespace {
+
+// Random vertices of `cells` cells of `per_cell` vertices each, spread over the vessel's box,
+// unwrapped by whole periods here and there.
+Points random_cloud(const Vessel& v, int cells, int per_cell, std::vector<int>& cell_of, unsigned seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(-0.5, 0.5);
+  std::uniform_int_distribution<int> shift(-1, 1);
+  Points x(cells * per_cell, 3);
+  cell_of.resize(x.rows());
+  for (int c = 0; c < cells; ++c) {
+    for (int k = 0; k < per_cell; ++k) {
+      const int i = c * per_cell + k;
+      cell_of[i] = c;
+      Vec3 p(u(rng) * v.length(), u(rng) * v.width(), u(rng) * v.height());
+      if (v.kind() == VesselKind::Tube) {
+        const double r = 0.5 * v.diameter() * std::sqrt(0.5 + u(rng)), phi = 6.283185307179586 * u(rng);
+        p.y() = r * std::cos(phi);
+        p.z() = r * std::sin(phi);
+      }
+      p += Vec3(shift(rng) * v.length(), v.periodic(1) ? shift(rng) * v.width() : 0.0, 0.0);
+      x.row(i) = p.transpose();
+    }
+  }
+  return x;
+}
+
+double reference_energy(const Vessel& v, const ContactLaw& law, const Points& x, const std::vector<int>& cell_of, Points& F) {
+  F.setZero(x.rows(), 3);
+  double e = 0;
+  for (Eigen::Index i = 0; i < x.rows(); ++i) {
+    for (Eigen::Index j = i + 1; j < x.rows(); ++j) {
+      if (cell_of[i] == cell_of[j]) continue;
+      const Vec3 d = v.minimum_image(row(x, i) - row(x, j));
+      const double r = d.norm();
+      if (r >= law.cutoff) continue;
+      e += law.energy(r);
+      F.row(i) += (law.force(r) / r * d).transpose();
+      F.row(j) -= (law.force(r) / r * d).transpose();
+    }
+  }
+  return e;
+}
+
+}  // namespace
+
+TEST(ContactLaw, SmoothCappedAndZeroBeyondTheCutoff) {
+  const ContactLaw law{2.5, 0.8};
+  EXPECT_DOUBLE_EQ(law.force(0.0), 2.5);
+  EXPECT_DOUBLE_EQ(law.force(-0.3), 2.5);
+  EXPECT_EQ(law.force(0.8), 0.0);
+  EXPECT_EQ(law.force(3.0), 0.0);
+  EXPECT_EQ(law.energy(0.8), 0.0);
+  // Zero slope at the cutoff: F(rc - h) = O(h^2).
+  EXPECT_LT(law.force(0.8 - 1e-4), 1e-7);
+  // F = -dU/dr, also past the wall (r < 0) where the energy grows linearly.
+  for (double r : {-0.2, 0.05, 0.3, 0.6, 0.79}) {
+    const double h = 1e-6;
+    EXPECT_NEAR(-(law.energy(r + h) - law.energy(r - h)) / (2 * h), law.force(r), 1e-8) << r;
+  }
+  EXPECT_THROW((ContactLaw{-1, 1}.validate()), Error);
+  EXPECT_THROW((ContactLaw{1, 0}.validate()), Error);
+  EXPECT_NO_THROW((ContactLaw{1, 1}.validate()));
+}
+
+TEST(ContactSearch, CellListEqualsAllPairsWithPeriodicImages) {
+  for (const Vessel& v : {Vessel::channel(4.0, 3.0, 5.0), Vessel::tube(4.0, 2.5), Vessel::box(2.0, 1.5, 1.2)}) {
+    std::vector<int> cell_of;
+    const Points x = random_cloud(v, 5, 60, cell_of, 7);
+    const ContactLaw law{1.3, 0.45};
+    ContactSearch search;
+    Points F = Points::Zero(x.rows(), 3), Fref;
+    const double e = search.add_cell_contact(v, law, x, cell_of, F);
+    const double eref = reference_energy(v, law, x, cell_of, Fref);
+    ASSERT_GT(eref, 0) << v.describe();  // the cloud is dense enough to have contacts
+    EXPECT_NEAR(e, eref, 1e-12 * eref) << v.describe();
+    EXPECT_LT((F - Fref).cwiseAbs().maxCoeff(), 1e-12) << v.describe();
+    // Newton's third law: the contact forces sum to zero.
+    EXPECT_LT(F.colwise().sum().norm(), 1e-12) << v.describe();
+    // A second call on the same workspace gives the same.
+    Points F2 = Points::Zero(x.rows(), 3);
+    EXPECT_EQ(search.add_cell_contact(v, law, x, cell_of, F2), e);
+    EXPECT_EQ(F2, F);
+  }
+}
+
+TEST(ContactSearch, ForcesAreMinusTheEnergyGradient) {
+  const Vessel v = Vessel::channel(3.0, 2.0, 2.0);
+  std::vector<int> cell_of;
+  Points x = random_cloud(v, 3, 40, cell_of, 11);
+  const ContactLaw law{0.7, 0.5};
+  ContactSearch search;
+  Points F = Points::Zero(x.rows(), 3), scratch = Points::Zero(x.rows(), 3);
+  search.add_cell_contact(v, law, x, cell_of, F);
+  const double h = 1e-6;
+  int checked = 0;
+  for (Eigen::Index i = 0; i < x.rows(); i += 3) {
+    for (int a = 0; a < 3; ++a) {
+      Points xp = x, xm = x;
+      xp(i, a) += h;
+      xm(i, a) -= h;
+      const double ep = search.add_cell_contact(v, law, xp, cell_of, scratch);
+      const double em = search.add_cell_contact(v, law, xm, cell_of, scratch);
+      EXPECT_NEAR(-(ep - em) / (2 * h), F(i, a), 1e-6) << i << " " << a;
+      checked += F(i, a) != 0 ? 1 : 0;
+    }
+  }
+  EXPECT_GT(checked, 10);
+}
+
+TEST(ContactSearch, OneCellFeelsNothingAndFarCellsFeelNothing) {
+  const Vessel v = Vessel::channel(3.0, 2.0, 2.0);
+  std::vector<int> cell_of;
+  const Points x = random_cloud(v, 1, 80, cell_of, 5);
+  ContactSearch search;
+  Points F = Points::Zero(x.rows(), 3);
+  EXPECT_EQ(search.add_cell_contact(v, ContactLaw{1, 0.5}, x, cell_of, F), 0.0);
+  EXPECT_EQ(F.cwiseAbs().maxCoeff(), 0.0);
+  // Two vertices of different cells 0.51 apart, cutoff 0.5: no force; 0.49: a force.
+  Points two(2, 3);
+  two << 0, 0, 0, 0.51, 0, 0;
+  const std::vector<int> owners = {0, 1};
+  Points F2 = Points::Zero(2, 3);
+  search.add_cell_contact(v, ContactLaw{1, 0.5}, two, owners, F2);
+  EXPECT_EQ(F2.cwiseAbs().maxCoeff(), 0.0);
+  two(1, 0) = 0.49;
+  search.add_cell_contact(v, ContactLaw{1, 0.5}, two, owners, F2);
+  EXPECT_LT(F2(0, 0), 0.0);  // pushed apart
+  EXPECT_GT(F2(1, 0), 0.0);
+  // Through the periodic boundary: x = -0.9 and +0.9 in a period of 2 are 0.2 apart.
+  two << -0.9, 0, 0, 0.9 + 2.0, 0, 0;  // the second one unwrapped by a period
+  Points F3 = Points::Zero(2, 3);
+  search.add_cell_contact(v, ContactLaw{1, 0.5}, two, owners, F3);
+  EXPECT_GT(F3(0, 0), 0.0);  // pushed towards +x, away from its neighbour's image at -1.1
+  EXPECT_NEAR(F3(0, 0), (ContactLaw{1, 0.5}.force(0.2)), 1e-12);
+}
+
+TEST(WallContact, PushesIntoTheFluidAndIsTheEnergyGradient) {
+  for (const Vessel& v : {Vessel::tube(4.0, 2.0), Vessel::channel(4.0, 2.0, 2.0)}) {
+    const ContactLaw law{2.0, 0.4};
+    Points x(4, 3);
+    x << 0.1, 1.8, 0.0,   // 0.2 from the tube's wall (and far from the channel's)
+        0.0, 0.0, -1.75,  // 0.25 from the bottom wall
+        0.3, 0.2, 0.1,    // far from both
+        0.0, 0.0, 2.1;    // past the top wall
+    Points F = Points::Zero(4, 3);
+    const double e = add_wall_contact(v, law, x, F);
+    EXPECT_GT(e, 0);
+    for (Eigen::Index i = 0; i < x.rows(); ++i) {
+      const Vec3 f = row(F, i), p = row(x, i);
+      EXPECT_GE(f.dot(v.wall_normal(p)), 0.0);
+      EXPECT_NEAR(f.norm(), law.force(v.wall_distance(p)), 1e-12);
+      for (int a = 1; a < 3; ++a) {
+        const double h = 1e-7;
+        Points xp = x, xm = x, scratch = Points::Zero(4, 3);
+        xp(i, a) += h;
+        xm(i, a) -= h;
+        const double d = -(add_wall_contact(v, law, xp, scratch) - add_wall_contact(v, law, xm, scratch)) / (2 * h);
+        EXPECT_NEAR(d, F(i, a), 1e-6) << v.describe() << " " << i << " " << a;
+      }
+    }
+    EXPECT_NEAR(F(3, 2), -2.0, 1e-12);  // capped, towards the fluid
+  }
+}
