@@ -534,18 +534,19 @@ def section_c(results, runs, t_end):
                for (G, kb) in PAIRS for n in triangles for c in cols]
     lines += study_runner.run_time_table(
         ["G", "kB_hat", "triangles", "method"], entries,
-        [("wall s", lambda s: f"{s['wall_seconds']:.0f}"), ("steps", lambda s: str(s["steps"])),
-         ("rejected", lambda s: str(s.get("rejected_steps", ""))),
-         ("velocity evaluations", lambda s: str(s.get("velocity_evaluations", ""))),
-         ("steps / s", lambda s: f"{s['steps'] / s['wall_seconds'] if s['wall_seconds'] > 0 else math.nan:.3g}"),
-         ("volume change", volume_change)], missing=None)
+        run_time_columns("velocity evaluations", ("steps / s", lambda s: (
+            f"{s['steps'] / s['wall_seconds'] if s['wall_seconds'] > 0 else math.nan:.3g}"))), missing=None)
     lines.append("")
     return lines
 
 
-def volume_change(s):
-    """The relative volume change at the end of a run, as the run-time tables show it."""
-    return f"{(s['final_volume'] - s['initial_volume']) / s['initial_volume']:.1e}"
+def run_time_columns(evaluations, *more):
+    """The measured columns of the run-time tables: wall time, accepted and rejected steps, the
+    velocity evaluations (headed `evaluations`), the columns `more` and the relative volume change."""
+    return [("wall s", lambda s: f"{s['wall_seconds']:.0f}"), ("steps", lambda s: str(s["steps"])),
+            ("rejected", lambda s: str(s.get("rejected_steps", ""))),
+            (evaluations, lambda s: str(s.get("velocity_evaluations", ""))), *more,
+            ("volume change", lambda s: f"{(s['final_volume'] - s['initial_volume']) / s['initial_volume']:.1e}")]
 
 
 def demote(lines, title):
@@ -766,12 +767,8 @@ def section_e(results, runs, fig_dir, rel, t_end, n, meta):
                  "no bending" if run.method == "none" else run.method], results.get(run)) for run in runs]
     lines += study_runner.run_time_table(
         ["G", "kB_hat", "method"], entries,
-        [("wall s", lambda s: f"{s['wall_seconds']:.0f}"), ("steps", lambda s: str(s["steps"])),
-         ("rejected", lambda s: str(s.get("rejected_steps", ""))),
-         ("BIM evaluations", lambda s: str(s.get("velocity_evaluations", ""))),
-         ("mean stages", lambda s: num(stat(s, "mean_stages"), 3)),
-         ("spectral radius max", lambda s: num(stat(s, "spectral_radius_max"), 3)),
-         ("volume change", volume_change)],
+        run_time_columns("BIM evaluations", ("mean stages", lambda s: num(stat(s, "mean_stages"), 3)),
+                         ("spectral radius max", lambda s: num(stat(s, "spectral_radius_max"), 3))),
         total=f"| | | **all {len(runs)} runs** | **{run_wall:.0f}** | | | **{evals}** | | | |",
         failure=lambda r: f"failed: {r.error}")
     lines.append("")
