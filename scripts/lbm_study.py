@@ -43,8 +43,8 @@ Cost: before the runs, the two smallest radii (and with --full the paper's latti
 and after), other lattices are scaled by node count from the largest measured one with as many
 triangles (the fluid dominates), and the script prints
 the seconds per step and the projected wall time of every run and of the whole study. --only-measure stops there. Runs are
-cached and resumable as in scripts/shear_study.py: a run whose summary.json matches is not run
-again, an interrupted run continues from its checkpoint (--resume). --no-runs writes the document
+cached and resumable as in every study (scripts/study_runner.py): a run whose summary.json matches is
+not run again, an interrupted run continues from its checkpoint (--resume). --no-runs writes the document
 from what is in the work folder (finished runs; running or missing ones are listed as such).
 
 --jobs N runs N runs at once (each its own process; give them OMP_NUM_THREADS=1 on a machine of N
@@ -55,16 +55,12 @@ Writes --doc (default docs/results/lbm.md) and its PNGs (docs/results/lbm/): the
 case and radius with D_inf and the BIM, D against 1 / R, D against gamma t and the two checks.
 """
 import argparse
-import csv
 import json
 import math
 import os
-import shlex
 import shutil
-import subprocess
 import sys
 import time
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -74,7 +70,10 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import study_runner  # noqa: E402
+from study_runner import ROOT, finished, fmt_g, read_json, read_summary, rel  # noqa: E402
+
 PAIRS = [(0.05, 0.0375), (0.2, 0.15)]
 METHODS = ["A", "B"]  # the paper's LBM methods (figure 15)
 TAU, REYNOLDS = 1.0, 0.2
@@ -91,12 +90,8 @@ KERNEL = "phi2"  # the study's immersed-boundary kernel (ESPResSo's)
 CHECK_KERNEL = "phi4"  # the kernel check's: twice the support
 
 
-def fmt_g(x):
-    return f"{x:g}"
-
-
 @dataclass(frozen=True)
-class LbmRun:
+class LbmRun(study_runner.StudyRun):
     method: str
     G: float
     kappa_b: float
@@ -145,9 +140,22 @@ class LbmRun:
                     ["--offset", ",".join([fmt_g(self.offset)] * 3)] if self.offset else []) + (
                     [] if self.kernel == KERNEL else ["--kernel", self.kernel])
 
+    def resume_key(self):
+        return {"solver": "lbm", "method": self.method, "mesh": f"mt1:{self.triangles}", "G": self.G,
+                "kappa_b_hat": self.kappa_b, "radius_lu": self.radius, "reynolds": self.reynolds,
+                "offset": [self.offset] * 3, "kernel": self.kernel, "box": list(self.box)}
+
+    def key(self):
+        return dict(self.resume_key(), t_end=self.t_end)
+
+    def assumed(self):
+        # Runs from before the options: the study's Re, no offset, its kernel; a box not written
+        # is taken as the run's.
+        return {"reynolds": REYNOLDS, "offset": [0.0] * 3, "kernel": KERNEL, "box": list(self.box)}
+
 
 @dataclass(frozen=True)
-class BimRun:
+class BimRun(study_runner.StudyRun):
     """A BIM run named as scripts/shear_study.py names it (so both studies share it)."""
     method: str
     G: float
@@ -168,80 +176,11 @@ class BimRun:
                 "--no-plot"] + (["--integrator", "rkc", "--rtol", "1e-7", "--atol", "1e-6",
                                  "--bim-quadrature", "tree"] if self.triangles == FINE_TRIANGLES else [])
 
+    def key(self):
+        return {"method": self.method, "G": self.G, "kappa_b_hat": self.kappa_b, "t_end": self.t_end}
 
-def close(a, b):
-    return a is not None and b is not None and abs(float(a) - float(b)) <= 1e-12 * max(1.0, abs(float(b)))
-
-
-def read_json(path):
-    try:
-        return json.loads(Path(path).read_text())
-    except (OSError, ValueError):
-        return None
-
-
-def read_summary(folder):
-    """summary.json of a finished run, with its wall time from timing.json (NaN where absent)."""
-    s = read_json(folder / "summary.json")
-    if s is not None:
-        timing = read_json(folder / "timing.json") or {}
-        s["wall_seconds"] = float(timing.get("wall_seconds", s.get("wall_seconds", math.nan)))
-    return s
-
-
-def lbm_matches(args, run):
-    try:
-        return (args.get("solver") == "lbm" and args.get("method") == run.method
-                and args.get("mesh") == f"mt1:{run.triangles}" and close(args.get("G"), run.G)
-                and close(args.get("kappa_b_hat"), run.kappa_b) and close(args.get("radius_lu"), run.radius)
-                and close(args.get("reynolds", REYNOLDS), run.reynolds)
-                and all(close(a, run.offset) for a in args.get("offset", [0.0, 0.0, 0.0]))
-                and args.get("kernel", KERNEL) == run.kernel
-                and all(close(a, b) for a, b in zip(args.get("box", []), run.box)))
-    except (TypeError, ValueError, AttributeError):
-        return False
-
-
-def finished_summary(folder, run):
-    s = read_summary(folder)
-    if s is not None and close(s.get("t_end"), run.t_end) and (
-            lbm_matches(s, run) if isinstance(run, LbmRun) else
-            (s.get("method") == run.method and close(s.get("G"), run.G) and close(s.get("kappa_b_hat"), run.kappa_b))):
-        return s
-    return None
-
-
-def launch(cmd, folder, resume):
-    cmd = cmd + (["--resume"] if resume else [])
-    with open(folder / "run.log", "a") as log:
-        log.write("$ " + shlex.join(cmd) + "\n")
-        log.flush()
-        return subprocess.run(cmd, stdout=log, stderr=log, cwd=ROOT).returncode
-
-
-def execute(run, folder, bendlab):
-    """Runs (or reuses, or resumes) one run; returns its summary or None."""
-    s = finished_summary(folder, run)
-    if s is not None:
-        print(f"cached   {folder.name}: D_steady {s['D_steady']:.4f}", flush=True)
-        return s
-    cp = read_json(folder / "checkpoint.json")
-    resume = cp is not None and (lbm_matches(cp.get("arguments", {}), run) if isinstance(run, LbmRun) else
-                                 cp.get("arguments", {}).get("method") == run.method)
-    if not resume and folder.exists():
-        shutil.rmtree(folder)
-    folder.mkdir(parents=True, exist_ok=True)
-    print(f"{'resume' if resume else 'start '}   {folder.name}", flush=True)
-    rc = launch([str(bendlab)] + run.arguments(folder), folder, resume)
-    if rc != 0 and resume:
-        shutil.rmtree(folder)
-        folder.mkdir(parents=True)
-        rc = launch([str(bendlab)] + run.arguments(folder), folder, False)
-    s = finished_summary(folder, run)
-    print(f"{'done    ' if s else 'FAILED  '} {folder.name}" + (f": D_steady {s['D_steady']:.4f}, "
-                                                             f"{s['wall_seconds']:.0f} s" if s else f" (exit {rc})"),
-          flush=True)
-    return s
+    def resume_key(self):
+        return {"method": self.method}
 
 
 def load_average():
@@ -254,6 +193,7 @@ def load_average():
 def measure_cost(runs, work, bendlab, steps):
     """Seconds per lattice step (fluid + membrane + IBM + sampling) of each (R, triangles, box),
     from a short run of `steps` steps; cached in work/cost.json."""
+    probes = study_runner.Runner(bendlab, work / "cost")
     cache_path = work / "cost.json"
     cache = read_json(cache_path) or {}
     for run in runs:
@@ -267,7 +207,7 @@ def measure_cost(runs, work, bendlab, steps):
         t_end = steps * probe.shear_rate()
         load = load_average()
         start, cpu0 = time.monotonic(), os.times()
-        rc = launch([str(bendlab)] + probe.arguments(folder, t_end=t_end), folder, False)
+        rc, _ = probes.launch([str(bendlab)] + probe.arguments(folder, t_end=t_end), folder)
         wall, cpu1 = time.monotonic() - start, os.times()
         cpu = (cpu1.children_user - cpu0.children_user) + (cpu1.children_system - cpu0.children_system)
         s = read_summary(folder)
@@ -307,12 +247,7 @@ def seconds_per_step(run, cost, key="seconds_per_step"):
 
 
 def read_series(folder):
-    try:
-        with open(folder / "timeseries.csv", newline="") as f:
-            rows = list(csv.DictReader(f))
-    except OSError:
-        return None
-    return {k: np.array([float(r[k]) for r in rows]) for k in ("gamma_t", "D")} if rows else None
+    return study_runner.read_series(folder, ("gamma_t", "D"))
 
 
 def steady_uncertainty(folder, window, blocks=5):
@@ -480,7 +415,7 @@ def main():
     print(f"load average now: {' '.join(load_average())}")
     for r in runs:
         sps, how = seconds_per_step(r, cost)
-        done = finished_summary(work / r.name, r) is not None
+        done = finished(work / r.name, r) is not None
         projected[r] = (sps * r.steps() if sps else None, how)
         cps, _ = seconds_per_step(r, cost, "cpu_seconds_per_step")
         projected[r] = projected[r] + (cps * r.steps() if cps else None,)
@@ -503,27 +438,18 @@ def main():
         # Each run has its own folder, so runs in parallel share nothing. The checks go first (cheap,
         # and they tell how far the extrapolation can be trusted), then figure 15's methods (in
         # METHODS order, kappa_b = 0 last), the cheapest first within each.
-        with ThreadPoolExecutor(max_workers=a.jobs) as pool:
-            if not a.no_bim:
-                list(pool.map(lambda b: execute(b, bim_work / b.name, bendlab), bim_runs))
-            rank = {m: i for i, m in enumerate(METHODS)}
-            ordered = sorted(runs, key=lambda r: (not is_check(r), is_placement(r), rank.get(r.method, len(METHODS)),
-                                                  r.steps() * math.prod(r.nodes()), r.name))
-            list(pool.map(lambda r: execute(r, work / r.name, bendlab), ordered))
+        if not a.no_bim:
+            study_runner.Runner(bendlab, bim_work, a.jobs).run_all(bim_runs)
+        rank = {m: i for i, m in enumerate(METHODS)}
+        ordered = sorted(runs, key=lambda r: (not is_check(r), is_placement(r), rank.get(r.method, len(METHODS)),
+                                              r.steps() * math.prod(r.nodes()), r.name))
+        study_runner.Runner(bendlab, work, a.jobs).run_all(ordered)
     write_doc(a, runs, bim_runs, work, bim_work, cost, projected, totals)
 
 
 def with_error(value, err):
     """0.21861(10): the value with its standard error in units of its last digit (5 decimals)."""
     return f"{value:.5f}" + (f"({max(1, round(err * 1e5))})" if err is not None else "")
-
-
-def rel(path):
-    """A folder as the document names it: relative to the repository when it lies inside."""
-    try:
-        return str(Path(path).resolve().relative_to(ROOT))
-    except ValueError:
-        return str(path)
 
 
 def is_check(run):
@@ -569,8 +495,8 @@ def write_doc(a, runs, bim_runs, work, bim_work, cost, projected, totals):
          f"box {' x '.join(fmt_g(b) for b in BOX)} R (walls at z = +-{fmt_g(BOX[2] / 2)} R), phi2 kernel, ESPResSo's",
          "volume force with kappa_V = 100 kappa_S, 1280 triangles (MT1), gamma t = "
          f"{fmt_g(a.t_end)}, steady D over the last half. D(R) = D_inf + a / R^p through the radii.", ""]
-    finished = sum(finished_summary(work / r.name, r) is not None for r in runs)
-    L += [f"**Finished LBM runs: {finished} of {len(runs)}.** Unfinished runs appear below with their status",
+    done = sum(finished(work / r.name, r) is not None for r in runs)
+    L += [f"**Finished LBM runs: {done} of {len(runs)}.** Unfinished runs appear below with their status",
           "(not run, or started with the gamma t of their last checkpoint) and their projected time.", ""]
     # Cost
     L += ["## Cost per step and projected time", "",
@@ -589,7 +515,7 @@ def write_doc(a, runs, bim_runs, work, bim_work, cost, projected, totals):
     L += ["", "| run | lattice steps | status | wall time |", "|---|---|---|---|"]
     for r in runs:
         folder = work / r.name
-        s = finished_summary(folder, r)
+        s = finished(folder, r)
         if s is not None:
             status, wall = "finished", f"{s['wall_seconds'] / 60:.1f} min"
         else:
@@ -636,7 +562,7 @@ def write_doc(a, runs, bim_runs, work, bim_work, cost, projected, totals):
         if not is_placement(r):
             continue
         centred = LbmRun(r.method, r.G, r.kappa_b, r.radius, r.triangles, r.box, r.t_end, r.reynolds)
-        s0, s1 = finished_summary(work / centred.name, centred), finished_summary(work / r.name, r)
+        s0, s1 = finished(work / centred.name, centred), finished(work / r.name, r)
         placements.setdefault(case_of(r), []).append(
             (r.radius, s0.get("D_steady") if s0 else None, s1.get("D_steady") if s1 else None))
     figs, fits, verdicts = [], {}, {}
@@ -647,7 +573,7 @@ def write_doc(a, runs, bim_runs, work, bim_work, cost, projected, totals):
         cells, pts, sig = [], [], []
         for R in radii_all:
             r = by_radius.get(R)
-            s = finished_summary(work / r.name, r) if r else None
+            s = finished(work / r.name, r) if r else None
             err = steady_uncertainty(work / r.name, s["steady_window"]) if s else None
             cells.append(with_error(s["D_steady"], err) if s and s.get("D_steady") is not None else "-")
             if s and s.get("D_steady") is not None and r.box == BOX:
@@ -674,7 +600,7 @@ def write_doc(a, runs, bim_runs, work, bim_work, cost, projected, totals):
 
         def bim_of(triangles):
             b = BimRun(m, G, kb, a.t_end, triangles)
-            bs = finished_summary(bim_work / b.name, b)
+            bs = finished(bim_work / b.name, b)
             return b, (bs.get("D_steady") if bs else None)
         b, bim_d = bim_of(tri)
         bim = f"{bim_d:.4f}" if bim_d is not None else "not run"
@@ -796,7 +722,7 @@ def write_doc(a, runs, bim_runs, work, bim_work, cost, projected, totals):
               "|---|---|---|---|---|---|"]
         for r in checks:
             base = LbmRun(r.method, r.G, r.kappa_b, r.radius, r.triangles, BOX, r.t_end)
-            s0, s1 = finished_summary(work / base.name, base), finished_summary(work / r.name, r)
+            s0, s1 = finished(work / base.name, base), finished(work / r.name, r)
             d0 = s0.get("D_steady") if s0 else None
             d1 = s1.get("D_steady") if s1 else None
             what = (f"kernel: {r.kernel}" if r.kernel != KERNEL else

@@ -23,24 +23,24 @@ All BIM runs use the stiff-stable Runge-Kutta-Chebyshev integrator (--integrator
 are bounded by the membrane's stiffness at G = 1e-3 (docs/results/stiff_stepping.md).
 
 Every run's folder lies under --work (default studies/rbc_shear, kept in git: studies/README.md). A
-run whose summary.json holds its arguments is not run again; an interrupted one continues from its
-checkpoint (--resume). Run the long parts in the background, one at a time:
+run whose summary.json reaches its t_end is not run again (scripts/study_runner.py); an interrupted
+one continues from its checkpoint (--resume). Run the long parts in the background, one at a time:
     OMP_NUM_THREADS=1 nohup /usr/bin/python3 scripts/rbc_shear_study.py --only sweep \\
         > results/rbc_shear_sweep.log 2>&1 &
 Writes docs/results/rbc_shear.md and its figures (docs/results/rbc_shear/) from every run that is
 done, and says which are missing.
 """
 import argparse
-import csv
-import json
 import math
 import os
-import subprocess
 import sys
 import time
+from dataclasses import dataclass
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import study_runner  # noqa: E402
+from study_runner import ROOT, fmt_g  # noqa: E402
 
 SKALAK_C = 10.0
 KAPPA_B_HAT = 0.002
@@ -85,18 +85,26 @@ def say(msg):
     print(time.strftime("%H:%M:%S"), msg, flush=True)
 
 
-def fmt_g(x):
-    return f"{x:g}"
+@dataclass(frozen=True)
+class Run(study_runner.StudyRun):
+    """A run of the study: its folder's name, its `bendlab shear` options, its end and its title.
+    A finished run is one whose summary reaches t_end; a run resumes from any checkpoint of its
+    folder, and starts afresh with --overwrite."""
+    name: str
+    args: tuple
+    t_end: float
+    title: str
+    start_arguments = ("--overwrite",)
 
+    def arguments(self, out):
+        return ["shear", *self.args, "--t-end", fmt_g(self.t_end), "--snapshot-every", "1", "--no-plot",
+                "--out", str(out)]
 
-class Run:
-    def __init__(self, name, args, t_end, label):
-        self.name, self.args, self.t_end, self.label = name, args, t_end, label
+    def resume_key(self):
+        return {}
 
-    def command(self, bendlab, out, resume):
-        cmd = [str(bendlab), "shear"] + self.args + ["--t-end", fmt_g(self.t_end), "--snapshot-every", "1",
-                                                      "--no-plot", "--out", str(out)]
-        return cmd + (["--resume"] if resume else ["--overwrite"])
+    def label(self):
+        return self.title
 
 
 def bim_args(shape, G, mesh, tilt, aspect=None, kappa=KAPPA_B_HAT):
@@ -116,14 +124,14 @@ def jeffery_run():
     args = ["--shape", j["shape"], "--aspect", fmt_g(j["aspect"]), "--membrane", "skalak", "--skalak-c",
             fmt_g(SKALAK_C), "--G", fmt_g(j["G"]), "--mesh", j["mesh"], "--integrator", "rkc", "--rtol",
             fmt_g(RTOL), "--atol", fmt_g(ATOL), "--bim-quadrature", QUADRATURE]
-    return Run(name, args, j["t_end"], "Jeffery check")
+    return Run(name, tuple(args), j["t_end"], "Jeffery check")
 
 
 def sweep_runs(Gs, triangles, t_end):
     runs = []
     for n in triangles:
         for G in Gs:
-            runs.append(Run(f"rbc_G{fmt_g(G)}_mt1-{n}", bim_args("rbc", G, f"mt1:{n}", TILT), t_end,
+            runs.append(Run(f"rbc_G{fmt_g(G)}_mt1-{n}", tuple(bim_args("rbc", G, f"mt1:{n}", TILT)), t_end,
                             f"RBC G = {fmt_g(G)}, {n} triangles"))
     return runs
 
@@ -135,8 +143,8 @@ def reference_runs(Gs, t_end):
     """The sweep's cell with a stress-free oblate spheroid of c/a = REFERENCE_ASPECT (of the cell's
     area) in place of the biconcave reference."""
     return [Run(f"rbc_G{fmt_g(G)}_ref-oblate{fmt_g(REFERENCE_ASPECT)}_mt1-1280",
-                bim_args("rbc", G, "mt1:1280", TILT) + ["--reference-shape", "oblate", "--reference-aspect",
-                                                         fmt_g(REFERENCE_ASPECT)],
+                (*bim_args("rbc", G, "mt1:1280", TILT), "--reference-shape", "oblate", "--reference-aspect",
+                 fmt_g(REFERENCE_ASPECT)),
                 t_end, f"RBC G = {fmt_g(G)}, oblate reference, 1280 triangles") for G in Gs]
 
 
@@ -147,50 +155,17 @@ def lbm_run(G, t_end, radius):
     args = ["--solver", "lbm", "--radius-lu", fmt_g(radius), "--box", "6,6,10", "--reynolds", "0.5", "--shape", "rbc", "--tilt", fmt_g(TILT), "--membrane",
             "skalak", "--skalak-c", fmt_g(SKALAK_C), "--G", fmt_g(G), "--mesh", "mt1:1280", "--method", METHOD,
             "--kappa-b-hat", fmt_g(KAPPA_B_HAT), "--sample-every", "0.01"]
-    return Run(f"lbm_rbc_G{fmt_g(G)}_R{fmt_g(radius)}_mt1-1280", args, t_end, f"RBC G = {fmt_g(G)}, LBM R = {radius}")
-
-
-def read_summary(folder):
-    p = folder / "summary.json"
-    if not p.is_file():
-        return None
-    s = json.loads(p.read_text())
-    try:
-        s["wall_seconds"] = float(json.loads((folder / "timing.json").read_text())["wall_seconds"])
-    except (OSError, ValueError, KeyError):
-        s["wall_seconds"] = float("nan")
-    return s
+    return Run(f"lbm_rbc_G{fmt_g(G)}_R{fmt_g(radius)}_mt1-1280", tuple(args), t_end,
+               f"RBC G = {fmt_g(G)}, LBM R = {radius}")
 
 
 def done(run, work):
-    s = read_summary(work / run.name)
-    return s if s is not None and abs(s.get("t_end", -1) - run.t_end) < 1e-9 else None
-
-
-def execute(run, work, bendlab):
-    out = work / run.name
-    if done(run, work):
-        say(f"done     {run.label}")
-        return
-    resume = (out / "checkpoint.json").is_file() and (out / "timeseries.csv").is_file()
-    out.mkdir(parents=True, exist_ok=True)
-    for attempt in ([True, False] if resume else [False]):
-        cmd = run.command(bendlab, out, attempt)
-        say(("resume   " if attempt else "start    ") + run.label + ": " + " ".join(cmd))
-        with open(out / "run.log", "a") as log:
-            log.write(" ".join(cmd) + "\n")
-            log.flush()
-            rc = subprocess.run(cmd, stdout=log, stderr=log, cwd=ROOT).returncode
-        if rc == 0:
-            return
-        say(f"failed (exit {rc}): {run.label}; see {out / 'run.log'}")
-    raise SystemExit(1)
+    """The summary of a finished run, else None."""
+    return study_runner.finished(work / run.name, run)
 
 
 def read_series(folder):
-    with open(folder / "timeseries.csv") as f:
-        rows = list(csv.DictReader(f))
-    return {k: [float(r[k]) for r in rows] for k in rows[0]} if rows else {}
+    return study_runner.read_series(folder) or {}
 
 
 def jeffery_angle(t, r, phi0):
@@ -301,7 +276,7 @@ def write_doc(args, work, doc, fig_dir, sweep, jeff, lbm, bim_ref, ref, wall_now
         s = done(run, work)
         rows.append((run, s))
     have = [(run, s) for run, s in rows if s is not None]
-    missing = [run.label for run, s in rows if s is None]
+    missing = [run.label() for run, s in rows if s is None]
     if have:
         L += ["| triangles | G | Ca = 3G | motion | tumbling period | tumbling frequency | tank-treading period | "
               "tank-treading frequency | swinging period | swing amplitude (deg) | D_steady | wall time |",
@@ -366,7 +341,7 @@ def write_doc(args, work, doc, fig_dir, sweep, jeff, lbm, bim_ref, ref, wall_now
     L += ["## BIM against LBM", ""]
     sb, sl = (done(bim_ref, work) if bim_ref else None), (done(lbm, work) if lbm else None)
     if sb is None or sl is None:
-        L += ["Not run yet" + (f" ({lbm.label} against {bim_ref.label})." if lbm else "."), ""]
+        L += ["Not run yet" + (f" ({lbm.label()} against {bim_ref.label()})." if lbm else "."), ""]
     else:
         begin, end = lbm.t_end / 2, lbm.t_end
         pb, kb = tumbling_period(read_series(work / bim_ref.name), begin, end)
@@ -417,8 +392,7 @@ def write_doc(args, work, doc, fig_dir, sweep, jeff, lbm, bim_ref, ref, wall_now
           "approximated), and its cell is at infinite dilution in unbounded shear (LBM: between walls). "
           "No quantitative transition value for viscosity ratio 1 was found in the abstracts read, so the "
           "comparison is qualitative: tumbling at low G, swinging with tank-treading at high G.", ""]
-    total = sum(s["wall_seconds"] for s in [done(r, work) for r in sweep + [jeff] + ref + ([lbm] if lbm else [])]
-                if s is not None and not math.isnan(s["wall_seconds"]))
+    total = study_runner.total_wall(done(r, work) for r in sweep + [jeff] + ref + ([lbm] if lbm else []))
     L += ["## Run time", "",
           f"The runs shown took {total:.0f} s of wall time together (sum of their timing.json `wall_seconds`, "
           f"one thread each, on a machine shared with other work); this invocation of the script took "
@@ -429,7 +403,7 @@ def write_doc(args, work, doc, fig_dir, sweep, jeff, lbm, bim_ref, ref, wall_now
     for run in [jeff] + sweep + ref + ([bim_ref, lbm] if lbm else []):
         if done(run, work) and run.name not in listed:
             listed.add(run.name)
-            L.append(" ".join(str(c) for c in run.command("bendlab", Path("studies/rbc_shear") / run.name, False)))
+            L.append(" ".join(study_runner.command("bendlab", run, Path("studies/rbc_shear") / run.name)))
     L += ["```", ""]
     doc.parent.mkdir(parents=True, exist_ok=True)
     doc.write_text("\n".join(L))
@@ -466,12 +440,12 @@ def main():
     todo = {"jeffery": [jeff], "sweep": sweep, "lbm": [bim_ref, lbm], "reference": ref, "doc": [],
             None: [jeff] + sweep}[a.only]
     if a.list:
-        for r in todo:
-            state = "done" if done(r, work) else ("resume" if (work / r.name / "checkpoint.json").is_file() else "run")
-            print(f"{state:7s} {r.label}: {' '.join(r.command(a.bendlab, work / r.name, state == 'resume'))}")
-        return
-    for r in todo:
-        execute(r, work, Path(a.bendlab))
+        return study_runner.Runner(a.bendlab, work).list(todo, f"part {a.only or 'jeffery and sweep'}")
+    if todo:
+        # One after the other; the document is written when every run has finished.
+        results = study_runner.Runner(study_runner.bendlab_binary(a.bendlab), work).run_all(todo)
+        if not all(r.ok for r in results.values()):
+            return 1
     doc_G = [float(x) for x in (a.doc_G or a.G).split(",")]
     doc_sweep = [r for n in (int(x) for x in a.doc_triangles.split(",")) for r in sweep_runs(doc_G, [n], a.t_end)]
     write_doc(a, work, doc, doc.parent / "rbc_shear", doc_sweep, jeff, lbm, bim_ref, ref, lambda: time.time() - start)

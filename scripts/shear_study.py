@@ -47,10 +47,10 @@ and whether it is done, resumes from a checkpoint or is still to run, and runs n
     /usr/bin/python3 scripts/shear_study.py --only e --list
 
 Every run is one `bendlab shear ... --no-plot` process whose output folder lies under --work
-(default studies/shear, kept in git: studies/README.md). A run whose summary.json exists and matches the arguments is not
-run again; a run that was interrupted continues from its checkpoint (--resume). Interrupting the
-study and starting it again with the same options therefore loses at most the work since the last
-checkpoint of each running run.
+(default studies/shear, kept in git: studies/README.md), started by scripts/study_runner.py. A run
+whose summary.json exists and matches the arguments is not run again; a run that was interrupted
+continues from its checkpoint (--resume). Interrupting the study and starting it again with the
+same options therefore loses at most the work since the last checkpoint of each running run.
 
 --add-methods S runs only Method S (and the cheap no-bending references) of parts (b) and (c)
 and writes them into a section of their own at the end of the existing --doc, keeping the rest:
@@ -62,21 +62,14 @@ gives a quick preview: the steady values and the average step size are then take
 half of each run (as `bendlab shear` does) and the document says so.
 """
 import argparse
-import csv
 import json
 import math
 import os
-import platform
 import re
-import shlex
-import shutil
-import signal
 import subprocess
 import sys
-import threading
 import time
-from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 import matplotlib
@@ -88,8 +81,9 @@ import numpy as np  # noqa: E402
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from inset_limits import inset_ylim  # noqa: E402
 import small_g_study  # noqa: E402
+import study_runner  # noqa: E402
+from study_runner import close, fmt_g, matches  # noqa: E402
 
-ROOT = Path(__file__).resolve().parent.parent
 METHODS = []  # the bending methods, from `bendlab methods --json` (set in main)
 G_SWEEP = [0.0125, 0.025, 0.05, 0.1, 0.2]
 PAIRS = [(0.05, 0.0375), (0.2, 0.15)]
@@ -108,11 +102,6 @@ RTOL, ATOL = "1e-7", "1e-6"
 # steps (a singular fit, a non-finite force: deterministic, so a rerun repeats it), is recorded in
 # the run's folder (failed.json) and reported, not retried: delete the folder to run it again.
 MAX_STEPS = 100_000
-
-
-def failed_while_stepping(error):
-    """Whether `error` is a failure of the run's own steps (not of its start, files or resume)."""
-    return "the run failed after step" in (error or "")
 FIG16_METHODS = ["C", "S"]  # figure 16: G = 0.05, kB_hat = 0.0375 (runs of figure 14)
 FIG17_KB = 2.0 / 15.0  # figure 17: Methods A and C at kB_hat = 2/15, G = 0.05 and 0.2
 FIG17_G = [0.05, 0.2]
@@ -155,8 +144,6 @@ METHOD_STYLE = {
     "M": dict(color="tab:cyan", ls="-."),
 }
 
-_print_lock = threading.Lock()
-
 
 def bending_methods(bendlab):
     """The names of the bending methods the binary knows, in its table's order."""
@@ -165,13 +152,7 @@ def bending_methods(bendlab):
 
 
 def say(msg):
-    with _print_lock:
-        print(msg, flush=True)
-
-
-def fmt_g(x):
-    """A number as it appears in folder names and on the command line."""
-    return f"{x:g}"
+    print(msg, flush=True)
 
 
 def fmt_arg(x):
@@ -182,7 +163,7 @@ def fmt_arg(x):
 
 
 @dataclass(frozen=True)
-class Run:
+class Run(study_runner.StudyRun):
     method: str  # "none" or a bending method
     triangles: int
     G: float
@@ -222,37 +203,27 @@ class Run:
             args += ["--bim-quadrature", self.quadrature]
         return args + ["--max-steps", str(MAX_STEPS)]
 
+    def resume_key(self):
+        """The arguments a checkpoint of this run holds."""
+        return {"method": self.method, "mesh": self.mesh, "G": self.G, "kappa_b_hat": self.kappa_b,
+                "integrator": self.integrator, "bim_quadrature": self.quadrature}
 
-@dataclass
-class Result:
-    run: Run
-    summary: dict | None = None
-    error: str | None = None
-    cached: bool = False
-    series: dict = field(default_factory=dict)
+    def key(self):
+        """The fields of the summary.json this run writes."""
+        key = dict(self.resume_key(), t_end=self.t_end)
+        if self.integrator != "cash-karp":
+            key.update(rtol=float(RTOL), atol=float(ATOL))
+        return key
 
-    @property
-    def ok(self):
-        return self.summary is not None
-
-
-def close(a, b):
-    return a is not None and b is not None and abs(float(a) - float(b)) <= 1e-12 * max(1.0, abs(float(b)))
+    def assumed(self):
+        # Summaries written before the options existed: Cash-Karp, every triangle by the 7-point rule.
+        return {"integrator": "cash-karp", "bim_quadrature": "all7"}
 
 
-def summary_matches(summary, run):
-    """Whether a summary.json was written by a run with the arguments of `run`."""
-    try:
-        ok = (summary.get("method") == run.method and summary.get("mesh") == run.mesh
-              and close(summary.get("G"), run.G) and close(summary.get("kappa_b_hat"), run.kappa_b)
-              and close(summary.get("t_end"), run.t_end)
-              and summary.get("integrator", "cash-karp") == run.integrator
-              and summary.get("bim_quadrature", "all7") == run.quadrature)
-        if ok and run.integrator != "cash-karp":
-            ok = close(summary.get("rtol"), float(RTOL)) and close(summary.get("atol"), float(ATOL))
-        return ok
-    except (TypeError, ValueError):
-        return False
+def runner(bendlab, work, jobs=1, progress_every=60.0):
+    """The study's runner: a failure is recorded with the step budget it ran under."""
+    return study_runner.Runner(bendlab, work, jobs, failure_fields={"max_steps": MAX_STEPS},
+                               progress_every=progress_every, say=say)
 
 
 # The steady window of each t_end, as `bendlab shear` reports it in summary.json (the library
@@ -260,41 +231,13 @@ def summary_matches(summary, run):
 _steady_windows = {}
 
 
-def read_summary(path):
-    """summary.json, with the run's wall time from timing.json beside it (NaN where absent)."""
-    try:
-        summary = json.loads(path.read_text())
-    except (OSError, ValueError):
-        return None
-    try:
-        summary["wall_seconds"] = float(json.loads((path.parent / "timing.json").read_text())["wall_seconds"])
-    except (OSError, ValueError, KeyError, TypeError):
-        summary.setdefault("wall_seconds", math.nan)
-    try:
-        _steady_windows[float(summary["t_end"])] = [float(x) for x in summary["steady_window"]]
-    except (KeyError, TypeError, ValueError):
-        pass
-    return summary
-
-
-def read_series(run_dir):
-    with open(run_dir / "timeseries.csv", newline="") as f:
-        rows = list(csv.DictReader(f))
-    cols = {}
-    for key in ("gamma_t", "D", "theta", "volume", "dt"):
-        cols[key] = np.array([float(r[key]) for r in rows]) if rows else np.zeros(0)
-    return cols
-
-
-def checkpoint_matches(run_dir, run):
-    try:
-        args = json.loads((run_dir / "checkpoint.json").read_text())["arguments"]
-    except (OSError, ValueError, KeyError, TypeError):
-        return False
-    return (args.get("method") == run.method and args.get("mesh") == run.mesh
-            and close(args.get("G"), run.G) and close(args.get("kappa_b_hat"), run.kappa_b)
-            and args.get("integrator", "cash-karp") == run.integrator
-            and args.get("bim_quadrature", "all7") == run.quadrature)
+def note_steady_windows(results):
+    """Remembers the steady window of each t_end from the finished runs' summaries."""
+    for r in results:
+        try:
+            _steady_windows[float(r.summary["t_end"])] = [float(x) for x in r.summary["steady_window"]]
+        except (AttributeError, KeyError, TypeError, ValueError):
+            pass
 
 
 def failure_reason(error):
@@ -302,144 +245,6 @@ def failure_reason(error):
     text = (error or "").removeprefix("bendlab: error: ")
     return re.sub(r"; the last checkpoint, at gamma t = ([0-9.eE+-]+), is whole in '[^']*'$",
                   r" (last checkpoint at gamma t = \1)", text)
-
-
-def _failure_identity(run):
-    return {"arguments": run.arguments("OUT"), "max_steps": MAX_STEPS}
-
-
-def write_failure(out, run, error):
-    """failed.json: a run that failed while stepping, so that the next study does not run it again."""
-    record = dict(_failure_identity(run), error=error)
-    tmp = out / "failed.json.tmp"
-    tmp.write_text(json.dumps(record, indent=1) + "\n")
-    os.replace(tmp, out / "failed.json")
-
-
-def read_failure(out, run):
-    """The error of a recorded failure of exactly this run (same arguments and budget), else None."""
-    try:
-        record = json.loads((out / "failed.json").read_text())
-    except (OSError, ValueError):
-        return None
-    if not isinstance(record, dict) or not isinstance(record.get("error"), str):
-        return None
-    if {k: record.get(k) for k in ("arguments", "max_steps")} != _failure_identity(run):
-        return None
-    return record["error"]
-
-
-def execute(run, work, bendlab, counter, total):
-    """Runs (or reuses) one `bendlab shear` run and returns its Result."""
-    out = work / run.name
-    summary = read_summary(out / "summary.json")
-    if summary is not None and summary_matches(summary, run):
-        n = counter.next()
-        say(f"[{n:2d}/{total}] cached   {run.label()}: D_steady {summary['D_steady']:.4f}, "
-            f"mean gamma dt {summary['mean_gamma_dt']:.3g}, {summary['wall_seconds']:.0f} s")
-        return Result(run, summary, cached=True)
-
-    failure = read_failure(out, run)
-    if summary is None and failure is not None:
-        n = counter.next()
-        say(f"[{n:2d}/{total}] cached   {run.label()}: FAILED ({failure}; delete {out} to run it again)")
-        return Result(run, None, error=failure, cached=True)
-
-    resume = summary is None and out.is_dir() and checkpoint_matches(out, run)
-    if not resume and out.exists():
-        shutil.rmtree(out)
-    out.mkdir(parents=True, exist_ok=True)
-    say(f"[  /{total}] {'resume ' if resume else 'start  '}  {run.label()}")
-    start = time.monotonic()
-    rc, err = _launch(run, out, bendlab, resume)
-    if rc != 0 and resume and not failed_while_stepping(err):
-        say(f"[  /{total}] resume failed, starting over: {run.label()}")
-        shutil.rmtree(out)
-        out.mkdir(parents=True)
-        rc, err = _launch(run, out, bendlab, False)
-    elapsed = time.monotonic() - start
-    summary = read_summary(out / "summary.json")
-    n = counter.next()
-    if rc != 0 or summary is None:
-        say(f"[{n:2d}/{total}] FAILED   {run.label()} (exit {rc}, {elapsed:.0f} s): {err}")
-        if failed_while_stepping(err):
-            write_failure(out, run, err)
-        return Result(run, None, error=err or f"exit status {rc}")
-    say(f"[{n:2d}/{total}] done     {run.label()}: D_steady {summary['D_steady']:.4f}, "
-        f"mean gamma dt {summary['mean_gamma_dt']:.3g}, {summary['steps']} steps, "
-        f"{summary['wall_seconds']:.0f} s")
-    return Result(run, summary)
-
-
-class Stopped(Exception):
-    """The study was interrupted; the run was not finished."""
-
-
-_live = set()  # running bendlab processes
-_live_lock = threading.Lock()
-_stopping = threading.Event()
-
-
-def _launch(run, out, bendlab, resume):
-    cmd = [str(bendlab)] + run.arguments(out) + (["--resume"] if resume else [])
-    with open(out / "run.log", "a") as log:
-        log.write("$ " + shlex.join(cmd) + "\n")
-        log.flush()
-        with _live_lock:
-            if _stopping.is_set():
-                raise Stopped()
-            proc = subprocess.Popen(cmd, stdout=log, stderr=log, cwd=ROOT, start_new_session=True)
-            _live.add(proc)
-        try:
-            rc = proc.wait()
-        finally:
-            with _live_lock:
-                _live.discard(proc)
-    if _stopping.is_set():
-        raise Stopped()
-    err = ""
-    if rc != 0:
-        lines = [l for l in (out / "run.log").read_text().splitlines() if l.strip()]
-        err = lines[-1] if lines else ""
-    return rc, err
-
-
-def _on_sigterm(signum, frame):
-    raise KeyboardInterrupt()
-
-
-def report_running(work, elapsed):
-    """One line per running run: its latest progress line."""
-    with _live_lock:
-        dirs = [Path(p.args[p.args.index("--out") + 1]) for p in _live]
-    for d in sorted(dirs):
-        last = ""
-        try:
-            for line in (d / "run.log").read_text().splitlines():
-                if line.startswith("gamma t ="):
-                    last = line
-        except OSError:
-            pass
-        say(f"  [{elapsed / 60:5.1f} min] {d.name}: {' '.join(last.split()) or 'starting'}")
-
-
-def stop_all():
-    """Stops the study: no new runs, the running ones are terminated (they keep their checkpoint)."""
-    with _live_lock:
-        _stopping.set()
-        for proc in _live:
-            proc.terminate()
-
-
-class Counter:
-    def __init__(self):
-        self._n = 0
-        self._lock = threading.Lock()
-
-    def next(self):
-        with self._lock:
-            self._n += 1
-            return self._n
 
 
 def part_runs(part, t_end, triangles, triangles_a, triangles_e=5120):
@@ -458,21 +263,15 @@ def part_runs(part, t_end, triangles, triangles_a, triangles_e=5120):
     raise ValueError(part)
 
 
-def cached_result(run, work):
-    summary = read_summary(work / run.name / "summary.json")
-    if summary is not None and summary_matches(summary, run):
-        return Result(run, summary, cached=True)
-    return None
-
-
 # ----------------------------------------------------------------------------- plots and tables
 
 def load_series(results, work):
     for r in results.values():
         if r.ok and not r.series:
             try:
-                r.series = read_series(work / r.run.name)
-            except (OSError, ValueError, KeyError):
+                columns = ("gamma_t", "D", "theta", "volume", "dt")
+                r.series = study_runner.read_series(work / r.run.name, columns) or {}
+            except (ValueError, KeyError):
                 r.series = {}
 
 
@@ -729,28 +528,25 @@ def section_c(results, runs, t_end):
     lines += ["### Run times", "",
               "Wall time of each `bendlab shear` run (one process, the machine shared with the "
               "other runs of the study), accepted steps, velocity evaluations and the relative "
-              "volume change at the end.", "",
-              "| G | kB_hat | triangles | method | wall s | steps | rejected | velocity evaluations | "
-              "steps / s | volume change |",
-              "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
-    for (G, kb) in PAIRS:
-        for n in triangles:
-            for c in cols:
-                r = results.get(Run(c, n, G, 0.0 if c == "none" else kb, t_end))
-                if r is None:
-                    continue
-                if not r.ok:
-                    lines.append(f"| {fmt_g(G)} | {fmt_g(kb)} | {n} | {c} | failed | | | | | |")
-                    continue
-                s = r.summary
-                w = s["wall_seconds"]
-                dv = (s["final_volume"] - s["initial_volume"]) / s["initial_volume"]
-                lines.append(f"| {fmt_g(G)} | {fmt_g(0.0 if c == 'none' else kb)} | {n} | "
-                             f"{'no bending' if c == 'none' else c} | {w:.0f} | {s['steps']} | "
-                             f"{s.get('rejected_steps', '')} | {s.get('velocity_evaluations', '')} | "
-                             f"{s['steps'] / w if w > 0 else math.nan:.3g} | {dv:.1e} |")
+              "volume change at the end.", ""]
+    entries = [([fmt_g(G), fmt_g(0.0 if c == "none" else kb), str(n), "no bending" if c == "none" else c],
+                results.get(Run(c, n, G, 0.0 if c == "none" else kb, t_end)))
+               for (G, kb) in PAIRS for n in triangles for c in cols]
+    lines += study_runner.run_time_table(
+        ["G", "kB_hat", "triangles", "method"], entries,
+        run_time_columns("velocity evaluations", ("steps / s", lambda s: (
+            f"{s['steps'] / s['wall_seconds'] if s['wall_seconds'] > 0 else math.nan:.3g}"))), missing=None)
     lines.append("")
     return lines
+
+
+def run_time_columns(evaluations, *more):
+    """The measured columns of the run-time tables: wall time, accepted and rejected steps, the
+    velocity evaluations (headed `evaluations`), the columns `more` and the relative volume change."""
+    return [("wall s", lambda s: f"{s['wall_seconds']:.0f}"), ("steps", lambda s: str(s["steps"])),
+            ("rejected", lambda s: str(s.get("rejected_steps", ""))),
+            (evaluations, lambda s: str(s.get("velocity_evaluations", ""))), *more,
+            ("volume change", lambda s: f"{(s['final_volume'] - s['initial_volume']) / s['initial_volume']:.1e}")]
 
 
 def demote(lines, title):
@@ -809,12 +605,12 @@ def section_e(results, runs, fig_dir, rel, t_end, n, meta):
     ok = [results[r] for r in runs if r in results and results[r].ok]
     failed = [r for r in runs if r in results and not results[r].ok]
     missing = [r for r in runs if r not in results]
-    run_wall = sum(r.summary["wall_seconds"] for r in ok if math.isfinite(r.summary["wall_seconds"]))
+    run_wall = study_runner.total_wall(r.summary for r in ok)
     evals = sum(int(r.summary.get("velocity_evaluations") or 0) for r in ok)
     cached = sum(1 for r in ok if r.cached)
     lines = [E_BEGIN, "",
              f"## (e) {n} triangles with the Runge-Kutta-Chebyshev integrator (figures 12, 14, 16, 17; table 4)",
-             "", "Generated by", "", f"    {meta['command']}", "",
+             "", *study_runner.generated_by(meta["command"]),
              f"- source commit: {meta['commit']}" if meta.get("commit") else None,
              f"- runs: {len(runs)} ({len(ok)} finished, {cached} of them taken from the work folder"
              + (f", {len(failed)} failed" if failed else "") + (f", {len(missing)} not run" if missing else "")
@@ -966,24 +762,16 @@ def section_e(results, runs, fig_dir, rel, t_end, n, meta):
     lines += [f"### (e.6) Run times, {n} triangles", "",
               "Each `bendlab shear` run: wall time (timing.json; the machine shared with the other runs of "
               "the study), accepted and rejected steps, BIM evaluations, mean stages per step, the largest "
-              "spectral radius estimate (x1.1) and the relative volume change at the end.", "",
-              "| G | kB_hat | method | wall s | steps | rejected | BIM evaluations | mean stages | "
-              "spectral radius max | volume change |",
-              "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
-    for run in runs:
-        r = results.get(run)
-        name = "no bending" if run.method == "none" else run.method
-        kb = "2/15" if close(run.kappa_b, FIG17_KB) else fmt_g(run.kappa_b)
-        if r is None or not r.ok:
-            lines.append(f"| {fmt_g(run.G)} | {kb} | {name} | {'not run' if r is None else 'failed: ' + str(r.error)} "
-                         "| | | | | | |")
-            continue
-        s = r.summary
-        dv = (s["final_volume"] - s["initial_volume"]) / s["initial_volume"]
-        lines.append(f"| {fmt_g(run.G)} | {kb} | {name} | {s['wall_seconds']:.0f} | {s['steps']} | "
-                     f"{s.get('rejected_steps', '')} | {s.get('velocity_evaluations', '')} | "
-                     f"{num(stat(s, 'mean_stages'), 3)} | {num(stat(s, 'spectral_radius_max'), 3)} | {dv:.1e} |")
-    lines += [f"| | | **all {len(runs)} runs** | **{run_wall:.0f}** | | | **{evals}** | | | |", ""]
+              "spectral radius estimate (x1.1) and the relative volume change at the end.", ""]
+    entries = [([fmt_g(run.G), "2/15" if close(run.kappa_b, FIG17_KB) else fmt_g(run.kappa_b),
+                 "no bending" if run.method == "none" else run.method], results.get(run)) for run in runs]
+    lines += study_runner.run_time_table(
+        ["G", "kB_hat", "method"], entries,
+        run_time_columns("BIM evaluations", ("mean stages", lambda s: num(stat(s, "mean_stages"), 3)),
+                         ("spectral radius max", lambda s: num(stat(s, "spectral_radius_max"), 3))),
+        total=f"| | | **all {len(runs)} runs** | **{run_wall:.0f}** | | | **{evals}** | | | |",
+        failure=lambda r: f"failed: {r.error}")
+    lines.append("")
     lines += quadrature_cross_check(results, runs, meta.get("work"))
     lines += [E_END, ""]
     return lines
@@ -1006,8 +794,9 @@ def quadrature_cross_check(results, runs, work):
         if r is None or not r.ok:
             continue
         name = run.name[: -len(E_QUADRATURE)] + other
-        s = read_summary(work / name / "summary.json")
-        if s is None or s.get("bim_quadrature") != other or not summary_matches({**s, "bim_quadrature": E_QUADRATURE}, run):
+        s = study_runner.read_summary(work / name)
+        if (s is None or s.get("bim_quadrature") != other
+                or not matches({**s, "bim_quadrature": E_QUADRATURE}, run.key(), run.assumed())):
             continue
         a, b = r.summary, s
         kb = "2/15" if close(run.kappa_b, FIG17_KB) else fmt_g(run.kappa_b)
@@ -1059,58 +848,6 @@ def added_runs(added, t_end, triangles):
             + [Run("none", n, G, 0.0, t_end) for (G, kb) in PAIRS for n in triangles])
 
 
-def source_commit():
-    """The short hash of HEAD, marked when tracked files other than results (docs/results, studies)
-    differ from it: the study's own outputs do not make its source uncommitted ('' outside git)."""
-    try:
-        commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
-                                text=True).stdout.strip()
-        if commit and subprocess.run(["git", "status", "--porcelain", "--untracked-files=no", "--", ".",
-                                      ":!docs/results", ":!studies"], cwd=ROOT,
-                                     capture_output=True, text=True).stdout.strip():
-            commit += " with uncommitted changes"
-        return commit
-    except OSError:
-        return ""
-
-
-def run_state(run, work):
-    """('done', summary) for a finished run, ('resume', checkpoint) for one that continues from its
-    checkpoint, ('run', None) for one still to start, as execute() would treat it."""
-    out = work / run.name
-    summary = read_summary(out / "summary.json")
-    if summary is not None and summary_matches(summary, run):
-        return "done", summary
-    if summary is None and out.is_dir() and checkpoint_matches(out, run):
-        try:
-            return "resume", json.loads((out / "checkpoint.json").read_text())
-        except (OSError, ValueError):
-            pass
-    return "run", None
-
-
-def list_runs(runs, work, bendlab, what):
-    """--list: the runs, their state and the command each is (or was) run with; runs nothing."""
-    say(f"{what}: {len(runs)} runs, in the order they are started; work folder {work}")
-    counts = {"done": 0, "resume": 0, "run": 0}
-    for run in runs:
-        state, info = run_state(run, work)
-        counts[state] += 1
-        cmd = [str(bendlab)] + run.arguments(work / run.name)
-        if state == "done":
-            note = (f"done: D_steady {num(info.get('D_steady'))}, {info.get('velocity_evaluations', '?')} "
-                    f"evaluations, {info['wall_seconds']:.0f} s")
-        elif state == "resume":
-            cmd.append("--resume")
-            note = (f"resumes at gamma t = {num(info.get('time'), 3)} of {fmt_g(run.t_end)} "
-                    f"({float(info.get('wall_seconds') or 0):.0f} s so far)")
-        else:
-            note = "to run"
-        say(f"  {run.label()}: {note}\n      $ {shlex.join(cmd)}")
-    say(f"{counts['done']} done, {counts['resume']} to resume from a checkpoint, {counts['run']} to run")
-    return 0
-
-
 # ----------------------------------------------------------------------------- main
 
 def main():
@@ -1160,13 +897,8 @@ def main():
     if not triangles:
         ap.error("--triangles is empty")
 
-    command = "/usr/bin/python3 scripts/shear_study.py" + "".join(" " + shlex.quote(a) for a in sys.argv[1:])
-    bendlab = Path(args.bendlab)
-    if not bendlab.is_absolute():
-        bendlab = (Path.cwd() / bendlab).resolve()
-    if not (bendlab.is_file() and os.access(bendlab, os.X_OK)):
-        sys.exit(f"error: no bendlab binary at '{args.bendlab}' (build it: cmake --preset release && "
-                 "cmake --build --preset release, or pass --bendlab PATH)")
+    command = study_runner.invocation(__file__, sys.argv[1:])
+    bendlab = study_runner.bendlab_binary(args.bendlab)
     METHODS[:] = bending_methods(bendlab)
     small_g_study.BENDLAB = bendlab  # writes the meshes its shape pictures need
     work = Path(args.work).resolve()
@@ -1181,8 +913,8 @@ def main():
         if unknown:
             ap.error(f"--add-methods: unknown method(s) {', '.join(unknown)} (known: {', '.join(METHODS)})")
         if args.list:
-            return list_runs(added_runs(added, args.t_end, triangles), work, bendlab,
-                             f"--add-methods {','.join(added)}")
+            return runner(bendlab, work).list(added_runs(added, args.t_end, triangles),
+                                              f"--add-methods {','.join(added)}")
         if not doc.is_file():
             ap.error(f"--add-methods: no document {doc} to add to")
         return add_methods(added, args, command, bendlab, work, doc, fig_dir, triangles)
@@ -1207,39 +939,22 @@ def main():
             return -(r.triangles ** 2) * (2 if r.method == "S" else 1) / math.sqrt(dt)
         return -(r.triangles ** 1.5) * (4 if r.method == "D" else 1) / dt
     todo.sort(key=cost)
+    study = runner(bendlab, work, args.jobs, args.progress_every)
     if args.list:
-        return list_runs(todo, work, bendlab, f"part(s) {', '.join(parts)}")
+        return study.list(todo, f"part(s) {', '.join(parts)}")
 
     say(f"shear study: {len(todo)} runs (parts {', '.join(parts)}), t_end {fmt_g(args.t_end)}, "
         f"{args.jobs} in parallel, work folder {work}")
     start = time.monotonic()
-    counter = Counter()
-    results = {}
-    signal.signal(signal.SIGTERM, _on_sigterm)
-    pool = ThreadPoolExecutor(max_workers=args.jobs)
-    try:
-        futures = {pool.submit(execute, r, work, bendlab, counter, len(todo)): r for r in todo}
-        pending = set(futures)
-        while pending:
-            done, pending = wait(pending, timeout=args.progress_every, return_when=FIRST_COMPLETED)
-            for f in done:
-                results[futures[f]] = f.result()
-            if not done:
-                report_running(work, time.monotonic() - start)
-    except KeyboardInterrupt:
-        stop_all()
-        pool.shutdown(wait=True, cancel_futures=True)
-        say("interrupted: finished runs are kept and running ones continue from their last checkpoint; "
-            "run the same command again to go on")
-        return 130
-    pool.shutdown(wait=True)
+    results = study.run_all(todo)
     wall = time.monotonic() - start
 
-    commit = source_commit()
+    commit = study_runner.source_commit()
     if parts == ["e"]:
+        note_steady_windows(results.values())
         load_series(results, work)
         meta = dict(command=command, commit=commit, wall=wall, jobs=args.jobs,
-                    cores=len(os.sched_getaffinity(0)), work=work)
+                    cores=study_runner.cores(), work=work)
         rel = os.path.relpath(fig_dir, doc.parent)
         block = "\n".join(section_e(results, runs_of["e"], fig_dir, rel, args.t_end, args.triangles_e, meta))
         text = doc.read_text() if doc.is_file() else (
@@ -1259,8 +974,8 @@ def main():
         if p in parts:
             shown.append(p)
             continue
-        cached = {r: cached_result(r, work) for r in runs_of[p]}
-        if all(c is not None for c in cached.values()):
+        cached = {r: study.cached(r) for r in runs_of[p]}
+        if all(c is not None and c.ok for c in cached.values()):
             results.update({r: c for r, c in cached.items() if r not in results})
             shown.append(p)
     # The no-bending reference curves of part (b), when they exist.
@@ -1268,27 +983,18 @@ def main():
     for n in triangles:
         for (G, kb) in PAIRS:
             r = Run("none", n, G, 0.0, args.t_end)
-            res = results.get(r) or cached_result(r, work)
-            if res is not None:
+            res = results.get(r) or study.cached(r)
+            if res is not None and res.ok:
                 results.setdefault(r, res)
                 none_results[(n, G)] = res
+    note_steady_windows(results.values())
     load_series(results, work)
 
-    run_wall = sum(r.summary["wall_seconds"] for r in results.values() if r.ok)
+    run_wall = study_runner.total_wall(r.summary for r in results.values() if r.ok)
     failed = [r for r in results.values() if not r.ok]
     rel = os.path.relpath(fig_dir, doc.parent)
-    cpu = ""
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    lines = ["# Capsule in shear flow (paper section 4)", "",
-             "Generated by", "", f"    {command}", "",
-             f"- machine: {len(os.sched_getaffinity(0))} cores (nproc){', ' + cpu if cpu else ''}, {platform.system()} "
-             f"{platform.machine()}; {args.jobs} runs in parallel",
+    lines = ["# Capsule in shear flow (paper section 4)", "", *study_runner.generated_by(command),
+             f"- machine: {study_runner.machine()}; {args.jobs} runs in parallel",
              f"- gamma t from 0 to **{fmt_g(args.t_end)}** in every run"
              + ("" if args.t_end >= 10 else " (a preview: the paper runs to 10)"),
              f"- total wall time of this invocation: {wall:.0f} s ({wall / 60:.1f} min); the runs shown "
@@ -1347,20 +1053,16 @@ def add_methods(added, args, command, bendlab, work, doc, fig_dir, triangles):
     runs = added_runs(added, args.t_end, triangles)
     say(f"shear study: adding {', '.join(added)}: {len(runs)} runs, {args.jobs} in parallel, work folder {work}")
     start = time.monotonic()
-    counter = Counter()
-    results = {}
-    signal.signal(signal.SIGTERM, _on_sigterm)
-    with ThreadPoolExecutor(max_workers=args.jobs) as pool:
-        for r, res in zip(runs, pool.map(lambda r: execute(r, work, bendlab, counter, len(runs)), runs)):
-            results[r] = res
+    results = runner(bendlab, work, args.jobs, args.progress_every).run_all(runs)
     wall = time.monotonic() - start
+    note_steady_windows(results.values())
     load_series(results, work)
     none_results = {(r.triangles, r.G): res for r, res in results.items() if r.method == "none"}
     rel = os.path.relpath(fig_dir, doc.parent)
     suffix = "_" + "".join(added)
-    commit = source_commit()
+    commit = study_runner.source_commit()
     lines = [ADDED_BEGIN, "", f"## (d) Methods added to the study: {', '.join(added)}", "",
-             "Generated by", "", f"    {command}", "",
+             *study_runner.generated_by(command),
              f"(source commit {commit}, {wall:.0f} s of wall time). The sections above come from the earlier "
              "invocation quoted at the top; its work folder (the time series of every run) is not kept in "
              f"the tree, so {', '.join(added)} cannot be drawn into the same figures without rerunning the "

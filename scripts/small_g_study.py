@@ -8,15 +8,14 @@ scripts/shear_study.py --only e, which calls `section` below).
     /usr/bin/python3 scripts/small_g_study.py --list     # the runs, their commands and state
     OMP_NUM_THREADS=1 nice -n 10 /usr/bin/python3 scripts/small_g_study.py --run [--bendlab PATH]
 
---run runs the missing runs one after the other (a run interrupted continues from its checkpoint
-with --resume), into studies/small_g/<name>/ (kept in git without snapshots: studies/README.md).
+--run runs the missing runs one after the other (scripts/study_runner.py; a run interrupted
+continues from its checkpoint with --resume), into studies/small_g/<name>/ (kept in git without
+snapshots: studies/README.md).
 The reference run is part (e)'s own, studies/shear/none_mt1-5120_G0.0125_kb0_t10_rkc_tree-mixed.
 """
 import argparse
-import csv
 import json
 import math
-import shlex
 import subprocess
 import sys
 import xml.etree.ElementTree as ET
@@ -25,14 +24,17 @@ from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import study_runner  # noqa: E402
+from study_runner import ROOT  # noqa: E402
+
 WORK = ROOT / "studies" / "small_g"
 SHEAR = ROOT / "studies" / "shear"
 SLOPE = 25.0 / 4.0  # small-deformation theory, D = 25/4 G (docs/results/shear.md, part (a))
 
 
 @dataclass(frozen=True)
-class SmallG:
+class SmallG(study_runner.StudyRun):
     method: str
     triangles: int
     G: float
@@ -51,11 +53,14 @@ class SmallG:
     def path(self):
         return ROOT / self.folder if self.folder else WORK / self.name
 
-    def command(self, bendlab):
-        return [str(bendlab), "shear", "--method", self.method, "--mesh", f"mt1:{self.triangles}",
+    def arguments(self, out):
+        return ["shear", "--method", self.method, "--mesh", f"mt1:{self.triangles}",
                 "--G", f"{self.G:g}", "--kappa-b-hat", f"{self.kb:g}", "--t-end", f"{self.t_end:g}",
-                "--out", str(self.path.relative_to(ROOT)), "--no-plot", "--integrator", self.integrator,
+                "--out", study_runner.rel(out), "--no-plot", "--integrator", self.integrator,
                 "--rtol", "1e-7", "--atol", "1e-6", "--bim-quadrature", self.quadrature]
+
+    def resume_key(self):
+        return {}  # any checkpoint in its folder
 
     def label(self):
         bend = "no bending" if self.method == "none" else f"Method {self.method}, kB_hat = {self.kb:g}"
@@ -86,31 +91,7 @@ PART_E = [SmallG("none", 5120, G, 0.0, 10.0, folder=f"studies/shear/none_mt1-512
 
 
 def summary(run):
-    try:
-        return json.loads((run.path / "summary.json").read_text())
-    except (OSError, ValueError):
-        return None
-
-
-def state(run):
-    s = summary(run)
-    if s is not None and math.isclose(s.get("t_end", -1), run.t_end):
-        return "done"
-    return "resume" if (run.path / "checkpoint.json").exists() else "to run"
-
-
-def execute(run, bendlab):
-    resume = state(run) == "resume"
-    run.path.mkdir(parents=True, exist_ok=True)
-    cmd = run.command(bendlab) + (["--resume"] if resume else [])
-    print(("resume " if resume else "start  ") + run.label(), flush=True)
-    with open(run.path / "run.log", "a") as log:
-        log.write("$ " + shlex.join(cmd) + "\n")
-        log.flush()
-        rc = subprocess.run(cmd, stdout=log, stderr=log, cwd=ROOT).returncode
-    s = summary(run)
-    print(f"  exit {rc}" + (f", D_steady {s['D_steady']:.5f}" if s else ""), flush=True)
-    return rc
+    return study_runner.read_summary(run.path)
 
 
 # ----------------------------------------------------------------------------- shapes
@@ -210,9 +191,7 @@ def snapshots(run):
 
 
 def read_series(run):
-    with open(run.path / "timeseries.csv", newline="") as f:
-        rows = list(csv.DictReader(f))
-    return {k: np.array([float(r[k]) for r in rows]) for k in ("gamma_t", "D", "theta")}
+    return study_runner.read_series(run.path, ("gamma_t", "D", "theta"))
 
 
 _mesh_cache = {}
@@ -312,15 +291,8 @@ def collect(runs):
         for ts, f in snapshots(run):
             rough_t.append((ts, roughness(read_vtp(f)[0])[0]))
         data[run] = dict(summary=s, series=read_series(run), x=x, rms=rms, max=mx, spectrum=sp,
-                         peak=peak, rough_t=rough_t, wall=_wall(run))
+                         peak=peak, rough_t=rough_t, wall=s["wall_seconds"])
     return data
-
-
-def _wall(run):
-    try:
-        return float(json.loads((run.path / "timing.json").read_text())["wall_seconds"])
-    except (OSError, ValueError, KeyError):
-        return math.nan
 
 
 STYLE = {
@@ -672,14 +644,13 @@ def main():
     global BENDLAB
     BENDLAB = Path(args.bendlab)
     if args.list or not args.run:
-        for run in [REFERENCE] + RUNS:
-            print(f"{state(run):7s} {run.label()}\n        {shlex.join(run.command(args.bendlab))}")
+        study_runner.Runner(args.bendlab, SHEAR).list([REFERENCE], "the reference, part (e)'s run")
+        study_runner.Runner(args.bendlab, WORK).list(RUNS, "small-G study")
     if args.run:
-        for run in RUNS:
-            if state(run) != "done":
-                if execute(run, args.bendlab) != 0:
-                    print(f"failed: {run.label()} (see {run.path / 'run.log'})", file=sys.stderr)
+        # One after the other; a failed run is reported and the next one starts.
+        results = study_runner.Runner(study_runner.bendlab_binary(args.bendlab), WORK).run_all(RUNS)
+        return 1 if any(not r.ok for r in results.values()) else 0
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

@@ -10,6 +10,7 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "scripts"))
 import lbm_study  # noqa: E402
+import study_runner  # noqa: E402
 
 
 def power_law(R, d_inf, a, p):
@@ -103,6 +104,11 @@ def test_placement_sigma_recovers_the_spread_of_one_placement():
     assert lbm_study.placement_sigma([]) is None
 
 
+def matches(record, run):
+    """Whether a summary's or checkpoint's arguments are those of `run` (the study's cache key)."""
+    return study_runner.matches(record, run.resume_key(), run.assumed())
+
+
 def summary_of(run):
     """The identity fields of a finished run's summary.json for `run` (default placement and kernel)."""
     return {"solver": "lbm", "method": run.method, "mesh": f"mt1:{run.triangles}", "G": run.G,
@@ -120,9 +126,9 @@ def test_placement_runs_are_named_and_started_apart_from_the_study():
     assert not lbm_study.is_check(moved)
     # A finished run's summary is matched with its own placement only.
     summary = summary_of(centred)
-    assert lbm_study.lbm_matches(summary, centred) and not lbm_study.lbm_matches(summary, moved)
+    assert matches(summary, centred) and not matches(summary, moved)
     summary["offset"] = [0.5, 0.5, 0.5]
-    assert lbm_study.lbm_matches(summary, moved) and not lbm_study.lbm_matches(summary, centred)
+    assert matches(summary, moved) and not matches(summary, centred)
 
 
 def test_kernel_check_runs_are_named_matched_and_kept_out_of_the_fit():
@@ -136,6 +142,6 @@ def test_kernel_check_runs_are_named_matched_and_kept_out_of_the_fit():
     assert not lbm_study.is_placement(wide)
     # A summary names its kernel; one without the field is the default kernel's (older runs).
     summary = summary_of(study)
-    assert lbm_study.lbm_matches(summary, study) and not lbm_study.lbm_matches(summary, wide)
+    assert matches(summary, study) and not matches(summary, wide)
     summary["kernel"] = "phi4"
-    assert lbm_study.lbm_matches(summary, wide) and not lbm_study.lbm_matches(summary, study)
+    assert matches(summary, wide) and not matches(summary, study)
