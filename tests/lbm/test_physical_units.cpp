@@ -33,8 +33,8 @@ TEST(FlowUnits, TimeStepFollowsFromTauAndTheViscosity) {
   const FlowUnits u = flow_units(in);
   EXPECT_NEAR(u.dt, 1e-7, 1e-7 * 1e-12);
   EXPECT_EQ(u.nx, 100);
-  EXPECT_EQ(u.ny, 52);
-  EXPECT_EQ(u.nz, 52);
+  EXPECT_EQ(u.ny, 54);  // 50 dx and two solid layers on either side
+  EXPECT_EQ(u.nz, 54);
   EXPECT_DOUBLE_EQ(u.section_lattice, 50);
   EXPECT_NEAR(u.steps_for(1e-3), 1e4, 0);
 }
@@ -63,10 +63,10 @@ TEST(FlowUnits, DrivingsArePoiseuillesLawBothWays) {
   ch.height_um = 10, ch.width_um = 5, ch.length_um = 20, ch.dx_um = 0.5, ch.tau = 0.8;
   ch.pseudo_shear_rate = 80;
   const FlowUnits c = flow_units(ch);
-  EXPECT_EQ(c.nz, 20);
+  EXPECT_EQ(c.nz, 24);  // 20 dx and two solid layers beyond each wall
   EXPECT_EQ(c.ny, 10);
   EXPECT_NEAR(c.body_force, 12 * 1.2e-3 * 80 * 10e-6 / (10e-6 * 10e-6), 1e-9 * c.body_force);
-  const double h = 0.5 * c.nz;
+  const double h = 0.5 * c.section_lattice;
   EXPECT_NEAR(c.body_force_lattice * h * h / (2 * c.nu_lattice), c.max_velocity_lattice, 1e-12 * c.max_velocity_lattice);
 }
 
@@ -101,4 +101,20 @@ TEST(FlowUnits, LatticeConfigHoldsTheTubeAndItsDriving) {
     }
   }
   EXPECT_EQ(L.num_fluid_nodes(), static_cast<std::size_t>(inside) * u.nx);
+}
+
+// The dimensionless groups of a cell in flow are the same in both unit systems: the capillary
+// number eta gamma R / G_s and the reduced bending modulus kB / (R^2 G_s).
+TEST(FlowUnits, MembraneModuliKeepTheDimensionlessGroups) {
+  const FlowUnits u = flow_units(tube(10, 20, 0.5, 1.3, 150));
+  const double R = 3.91e-6, Gs = 5.3e-6, kB = 2e-19;
+  const double gamma = u.pseudo_shear_rate;
+  const double ca = 1.2e-3 * gamma * R / Gs;
+  const double R_lattice = R / u.dx(), gamma_lattice = gamma * u.dt;
+  const double ca_lattice = u.nu_lattice * gamma_lattice * R_lattice / u.to_lattice_modulus(Gs);  // rho0 = 1
+  EXPECT_NEAR(ca_lattice, ca, 1e-12 * ca);
+  EXPECT_NEAR(u.to_lattice_energy(kB) / (R_lattice * R_lattice * u.to_lattice_modulus(Gs)), kB / (R * R * Gs), 1e-12 * kB / (R * R * Gs));
+  // A force is a modulus times a length; the body force density a force per volume.
+  EXPECT_NEAR(u.to_lattice_force(Gs * R), u.to_lattice_modulus(Gs) * R_lattice, 1e-12 * u.to_lattice_force(Gs * R));
+  EXPECT_NEAR(u.to_lattice_force(u.body_force * u.dx() * u.dx() * u.dx()), u.body_force_lattice, 1e-12 * u.body_force_lattice);
 }

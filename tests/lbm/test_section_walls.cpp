@@ -34,18 +34,6 @@ void run_to_steady(Lattice& L, double tol, int max_steps) {
   FAIL() << "no steady state in " << max_steps << " steps";
 }
 
-// A slab |z| < h as a cross-section whose walls lie exactly halfway between nodes.
-class HalfwaySlab final : public SectionWalls {
- public:
-  explicit HalfwaySlab(double h) : h_(h) {}
-  bool solid(double, double z) const override { return std::abs(z) > h_; }
-  double link_fraction(double, double, int, int) const override { return 0.5; }
-  std::string describe() const override { return "slab"; }
-
- private:
-  double h_;
-};
-
 }  // namespace
 
 TEST(TubeWall, LinkFractionsAreTheCircleIntersections) {
@@ -133,8 +121,8 @@ TEST(Lattice, TrtChannelPoiseuilleIsExactAtAnyTau) {
   }
 }
 
-// A cross-section whose walls sit exactly halfway reduces the interpolated bounce-back to the
-// plain one: the fluid evolves bit for bit as between the flat walls of the reference path.
+// The slab's walls sit exactly halfway, which reduces the interpolated bounce-back to the plain
+// one: the fluid evolves bit for bit as between the flat walls of the reference path.
 TEST(Lattice, HalfwaySectionWallsEqualFlatWalls) {
   const int H = 10;
   for (Collision coll : {Collision::BGK, Collision::TRT}) {
@@ -144,7 +132,7 @@ TEST(Lattice, HalfwaySectionWallsEqualFlatWalls) {
     LatticeConfig slab = flat;
     slab.nz = H + 2;
     slab.walls = false;
-    slab.section = std::make_shared<HalfwaySlab>(0.5 * H);
+    slab.section = std::make_shared<SlabWall>(0.5 * H);
     Lattice A(flat), B(slab);
     EXPECT_EQ(B.num_fluid_nodes(), A.num_nodes());
     auto start = [](const Vec3& x) { return Vec3(0.01 * std::cos(x.z()), 0.003 * std::sin(x.x()), 0.0); };
@@ -214,6 +202,16 @@ TEST(Lattice, RejectsASectionThatDoesNotCloseOrLeavesNoFluid) {
   EXPECT_THROW(Lattice{c}, Error);
   c.section = std::make_shared<TubeWall>(4.0);
   EXPECT_NO_THROW(Lattice{c});
+  {
+    // A solid node reports the wall's velocity, zero, whatever the body force.
+    LatticeConfig moving = c;
+    moving.body_force = Vec3(1e-3, 0, 0);
+    Lattice L(moving);
+    L.run(3);
+    EXPECT_TRUE(L.is_solid(L.index(0, 0, 0)));
+    EXPECT_EQ(L.velocity(L.index(0, 0, 0)), Vec3::Zero());
+    EXPECT_GT(L.velocity(L.index(0, 5, 5)).x(), 0.0);
+  }
   c.collision = Collision::TRT;
   c.trt_magic = 0;
   EXPECT_THROW(Lattice{c}, Error);

@@ -733,6 +733,7 @@ double Lattice::density(std::size_t node) const {
 }
 
 Vec3 Lattice::velocity(std::size_t node) const {
+  if (is_solid(node)) return Vec3::Zero();  // the resting wall
   double f[kQ];
   populations(node, f);
   double rho = 0;

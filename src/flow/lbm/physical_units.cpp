@@ -32,6 +32,19 @@ std::string to_string(FlowGeometry geometry) { return geometry == FlowGeometry::
 
 double FlowUnits::steps_for(double s) const { return std::ceil(s / dt - 1e-9); }
 
+double FlowUnits::to_lattice_force(double newtons) const {
+  const double h = dx();
+  return newtons * dt * dt / (input.plasma.density * h * h * h * h);
+}
+double FlowUnits::to_lattice_modulus(double newtons_per_metre) const {
+  const double h = dx();
+  return newtons_per_metre * dt * dt / (input.plasma.density * h * h * h);
+}
+double FlowUnits::to_lattice_energy(double joules) const {
+  const double h = dx();
+  return joules * dt * dt / (input.plasma.density * h * h * h * h * h);
+}
+
 FlowUnits flow_units(const FlowUnitsInput& in) {
   FlowUnits u;
   u.input = in;
@@ -63,16 +76,18 @@ FlowUnits flow_units(const FlowUnitsInput& in) {
       throw Error(fmt::format("--diameter {} um is {} dx: a tube needs at least 4 dx across", in.diameter_um, u.section_lattice));
     }
     if (u.section_lattice > 1e5) throw Error(fmt::format("--diameter {} um is {} dx: too many lattice nodes", in.diameter_um, u.section_lattice));
-    // One solid row at least on every side, so that every wall link ends in the solid.
-    u.ny = u.nz = static_cast<int>(std::ceil(u.section_lattice - 1e-9)) + 2;
+    // Two solid rows at least on every side: every wall link ends in the solid, and an immersed
+    // boundary's stencil near the wall reaches resting solid rows, not the far side of the box.
+    u.ny = u.nz = static_cast<int>(std::ceil(u.section_lattice - 1e-9)) + 4;
   } else {
     require_positive(in.height_um, "--height");
     require_positive(in.width_um, "--width");
-    u.nz = whole_cells(in.height_um, in.dx_um, "--height");
+    const int H = whole_cells(in.height_um, in.dx_um, "--height");
     u.ny = whole_cells(in.width_um, in.dx_um, "--width");
-    if (u.nz < 4) throw Error(fmt::format("--height {} um is {} dx: a channel needs at least 4 dx across", in.height_um, u.nz));
+    if (H < 4) throw Error(fmt::format("--height {} um is {} dx: a channel needs at least 4 dx across", in.height_um, H));
+    u.nz = H + 4;  // two solid layers beyond each wall, as for the tube
     section = in.height_um * 1e-6;
-    u.section_lattice = u.nz;
+    u.section_lattice = H;
   }
   u.nu = eta / in.plasma.density;
   u.nu_lattice = (in.tau - 0.5) / 3.0;
@@ -121,12 +136,11 @@ LatticeConfig flow_lattice_config(const FlowUnits& u) {
   c.tau = u.input.tau;
   c.collision = Collision::TRT;
   c.body_force = Vec3(u.body_force_lattice, 0, 0);
+  c.walls = false;
   if (u.input.geometry == FlowGeometry::Tube) {
-    c.walls = false;
     c.section = std::make_shared<TubeWall>(0.5 * u.section_lattice);
   } else {
-    c.walls = true;
-    c.wall_velocity = 0;
+    c.section = std::make_shared<SlabWall>(0.5 * u.section_lattice);
   }
   return c;
 }

@@ -30,4 +30,18 @@ double TubeWall::link_fraction(double y, double z, int cy, int cz) const {
 
 std::string TubeWall::describe() const { return fmt::format("tube of diameter {:g} dx", 2 * radius_); }
 
+SlabWall::SlabWall(double half_height) : h_(half_height) {
+  if (!(half_height > 0) || !std::isfinite(half_height)) throw Error(fmt::format("slab half-height {} must be finite and positive", half_height));
+}
+
+bool SlabWall::solid(double, double z) const { return std::abs(z) >= h_; }
+
+double SlabWall::link_fraction(double, double z, int, int cz) const {
+  if (cz == 0) throw Error("slab wall: a link parallel to the walls never meets them");
+  const double wall = cz > 0 ? h_ : -h_;
+  return std::clamp((wall - z) / cz, 1e-12, 1.0);
+}
+
+std::string SlabWall::describe() const { return fmt::format("channel of height {:g} dx", 2 * h_); }
+
 }  // namespace bendlab::lbm

@@ -174,7 +174,8 @@ class Lattice {
   /// The 19 post-stream populations of a node at the current step (layout-independent).
   void populations(std::size_t node, double f[kQ]) const;
   double density(std::size_t node) const;
-  /// u = (sum f c + F/2) / rho with the current force field.
+  /// u = (sum f c + F/2) / rho with the current force field (and the body force); zero at a node
+  /// in the solid of the cross-section (the resting wall, which the immersed boundary then sees).
   Vec3 velocity(std::size_t node) const;
   /// Sum of rho, and of sum f c (without F/2), over all fluid nodes.
   double total_mass() const;

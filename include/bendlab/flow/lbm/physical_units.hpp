@@ -11,6 +11,7 @@
 // and the lattice units from
 //   nu = eta / rho,  nu_lattice = (tau - 1/2) / 3,  dt = nu_lattice dx^2 / nu,
 //   g_lattice = g dt^2 / (rho dx),  u_lattice = u dt / dx,
+//   F_lattice = F dt^2 / (rho dx^4),  k_lattice = k dt^2 / (rho dx^3) (N/m),  E_lattice = E dt^2 / (rho dx^5),
 // Mach number Ma = sqrt(3) u_max,lattice, Reynolds number Re = v D / nu (or v H / nu).
 #include <optional>
 #include <string>
@@ -47,7 +48,7 @@ struct FlowUnitsInput {
 
 struct FlowUnits {
   FlowUnitsInput input;
-  int nx = 0, ny = 0, nz = 0;     ///< lattice nodes (the tube's box adds one solid layer around it)
+  int nx = 0, ny = 0, nz = 0;     ///< lattice nodes (two solid layers beyond every wall)
   double dt = 0;                  ///< s per step
   double nu = 0, nu_lattice = 0;  ///< m^2/s, dx^2/dt
   double body_force = 0;          ///< g, N/m^3
@@ -66,6 +67,11 @@ struct FlowUnits {
   /// Lattice velocity of a physical one (m/s) and back.
   double to_lattice_velocity(double u) const { return u * dt / dx(); }
   double to_physical_velocity(double u_lattice) const { return u_lattice * dx() / dt; }
+  /// Lattice values of a force (N), a surface modulus or tension (N/m) and an energy (J): the
+  /// lattice's mass unit is rho dx^3, its time unit dt.
+  double to_lattice_force(double newtons) const;
+  double to_lattice_modulus(double newtons_per_metre) const;
+  double to_lattice_energy(double joules) const;
   /// The lines a run prints about the units it chose.
   std::vector<std::string> describe() const;
 };
@@ -77,8 +83,8 @@ struct FlowUnits {
 FlowUnits flow_units(const FlowUnitsInput& input);
 
 /// The lattice of these units: TRT (walls exactly placed at any tau), the body force along x,
-/// and either the tube's cross-section (TubeWall of radius D / (2 dx), interpolated bounce-back)
-/// or the channel's flat resting walls at z = -+H/2, periodic in x and y.
+/// and the cross-section: the tube's (TubeWall of radius D / (2 dx), interpolated bounce-back) or
+/// the channel's (SlabWall at z = -+H/2, halfway between nodes), periodic in x (and y).
 LatticeConfig flow_lattice_config(const FlowUnits& units);
 
 }  // namespace bendlab::lbm

@@ -42,4 +42,21 @@ class TubeWall final : public SectionWalls {
   double radius_;
 };
 
+/// The slit |z| < h between plane walls at z = -+h (y periodic): a channel as a cross-section, so
+/// that its walls take the same path as a tube's (an immersed boundary's stencil may reach into the
+/// solid rows, which rest). With h a whole number of dx / 2 from the box centre every wall lies
+/// halfway between nodes (fraction 1/2) and the lattice steps bit for bit as between flat walls.
+class SlabWall final : public SectionWalls {
+ public:
+  /// Throws bendlab::Error for a half-height that is not finite and positive.
+  explicit SlabWall(double half_height);
+  double half_height() const { return h_; }
+  bool solid(double y, double z) const override;
+  double link_fraction(double y, double z, int cy, int cz) const override;
+  std::string describe() const override;
+
+ private:
+  double h_;
+};
+
 }  // namespace bendlab::lbm

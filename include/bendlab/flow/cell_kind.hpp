@@ -1,0 +1,53 @@
+#pragma once
+// A kind of cell in physical units (um, N/m, J), with the literature's defaults for a human red
+// blood cell (shared/spec/CELLS_IN_CHANNELS.md section 2; docs/conventions.md §6 cites each):
+//   shape      the red blood cell of the paper's eq. (15) with R = 3.91 um (diameter 7.82 um)
+//   mesh       mt1:1280 (1280 triangles, 642 vertices; edges about 0.45 um)
+//   membrane   Skalak law, G_s = 5.3 uN/m, C = 10; bending modulus 2e-19 J; Method C
+//   volume     ESPResSo's volume force with kappa_V = 100 kappa_S in lattice units, as the
+//              capsule runs use it
+// Every cell of a kind shares its topology, reference shape and bending method: per cell a run
+// keeps positions and forces only.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "bendlab/bending/bending_method.hpp"
+#include "bendlab/flow/lbm/physical_units.hpp"
+#include "bendlab/membrane/membrane_model.hpp"
+#include "bendlab/mesh/trimesh.hpp"
+
+namespace bendlab {
+
+struct CellKindSpec {
+  std::string shape = "rbc";          ///< rbc (eq. (15)) or sphere
+  double radius_um = 3.91;            ///< rbc: R of eq. (15), the large half-axis; sphere: its radius
+  std::string mesh = "mt1:1280";      ///< a mesh_from_spec() name
+  std::string elastic_law = "skalak"; ///< skalak or neo-hookean
+  double shear_modulus = 5.3e-6;      ///< G_s, N/m (k_S = 3 G_s, docs/conventions.md §2)
+  double skalak_c = 10;               ///< the Skalak law's C (area modulus G_s (1 + 2 C))
+  double bending_modulus = 2e-19;     ///< kappa_B, J
+  std::string method = "C";           ///< bending method
+  std::vector<std::string> method_options;  ///< name=value
+  double volume_modulus_ratio = 100;  ///< kappa_V / kappa_S of ESPResSo's volume force (lattice units)
+};
+
+/// Throws bendlab::Error, naming the option, for an unknown shape or law, a non-positive or
+/// non-finite radius or modulus, a negative bending modulus, C <= -1/2.
+void check_cell_kind(const CellKindSpec& spec);
+
+struct CellKind {
+  CellKindSpec spec;
+  TriMesh reference_um;   ///< the stress-free shape in um, volume centroid at the origin, axis e_z
+  double volume_um3 = 0;  ///< of the mesh
+  double area_um2 = 0;
+  double mean_edge_um = 0;
+};
+
+CellKind make_cell_kind(const CellKindSpec& spec);
+
+/// The membrane of a kind in lattice units (positions in dx, moduli by FlowUnits), sharing the
+/// kind's topology and one bending method.
+std::shared_ptr<const MembraneModel> lattice_membrane(const CellKind& kind, const lbm::FlowUnits& units);
+
+}  // namespace bendlab

@@ -1,0 +1,91 @@
+#include "bendlab/flow/lbm/lbm_suspension.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+#include "bendlab/geometry/measures.hpp"
+
+namespace bendlab::lbm {
+
+namespace {
+SuspensionOptions checked(SuspensionOptions o) {
+  o.cell_contact.validate();
+  o.wall_contact.validate();
+  if (!o.vertex_force.allFinite()) throw Error("suspension: the force per vertex is not finite");
+  const LatticeConfig& c = o.lattice;
+  if (std::abs(o.vessel.length() - c.nx) > 1e-9 || (o.vessel.periodic(1) && std::abs(o.vessel.width() - c.ny) > 1e-9)) {
+    throw Error(fmt::format("suspension: the {} does not match the lattice's periods ({} x {} nodes)", o.vessel.describe(), c.nx, c.ny));
+  }
+  return o;
+}
+}  // namespace
+
+LbmSuspension::LbmSuspension(SuspensionOptions options) : options_(checked(std::move(options))), lattice_(options_.lattice) {}
+
+int LbmSuspension::add_cell(std::shared_ptr<const MembraneModel> membrane, const Points& X) {
+  if (!membrane) throw Error("suspension: no membrane model for the cell");
+  if (X.rows() != membrane->num_vertices() || X.cols() != 3) {
+    throw Error(fmt::format("suspension: {} positions for a membrane of {} vertices", X.rows(), membrane->num_vertices()));
+  }
+  if (!X.allFinite()) throw Error("suspension: a cell position is not finite");
+  const int c = num_cells();
+  const Eigen::Index first = X_.rows();
+  Points grown(first + X.rows(), 3);
+  grown.topRows(first) = X_;
+  grown.bottomRows(X.rows()) = X;
+  X_ = std::move(grown);
+  cells_.push_back(Cell{std::move(membrane), first});
+  cell_of_.resize(X_.rows(), c);
+  F_.setZero(X_.rows(), 3);
+  U_.setZero(X_.rows(), 3);
+  return c;
+}
+
+void LbmSuspension::step() {
+  const std::int64_t n = lattice_.step_count() + 1;
+  try {
+    // 1. Forces at X(t).
+    for (const Cell& cell : cells_) {
+      const Eigen::Index rows = cell.membrane->num_vertices();
+      scratch_x_ = X_.middleRows(cell.first, rows);
+      cell.membrane->forces(scratch_x_, scratch_f_);
+      F_.middleRows(cell.first, rows) = scratch_f_;
+    }
+    if (options_.vertex_force != Vec3::Zero()) F_.rowwise() += options_.vertex_force.transpose();
+    cell_contact_energy_ = wall_contact_energy_ = 0;
+    if (options_.cell_contact.max_force > 0 && cells_.size() > 1) {
+      cell_contact_energy_ = contact_.add_cell_contact(options_.vessel, options_.cell_contact, X_, cell_of_, F_);
+    }
+    if (options_.wall_contact.max_force > 0 && options_.vessel.kind() != VesselKind::Box) {
+      wall_contact_energy_ = add_wall_contact(options_.vessel, options_.wall_contact, X_, F_);
+    }
+    // 2-4.
+    ib_step(lattice_, X_, F_, U_, options_.kernel);
+  } catch (const Error& e) {
+    throw Error(fmt::format("suspension step {}: {}", n, e.what()));
+  }
+  for (Eigen::Index k = 0; k < X_.rows(); ++k) {
+    if (!std::isfinite(X_(k, 0)) || !std::isfinite(X_(k, 1)) || !std::isfinite(X_(k, 2))) {
+      const int c = cell_of_[k];
+      throw Error(fmt::format("suspension blew up at step {}: vertex {} of cell {} has a non-finite position", n,
+                              k - cells_[c].first, c));
+    }
+  }
+  wrap_cells();
+}
+
+void LbmSuspension::wrap_cells() {
+  const Vec3 period = options_.vessel.period();
+  for (const Cell& cell : cells_) {
+    const Eigen::Index rows = cell.membrane->num_vertices();
+    const Vec3 centre = X_.middleRows(cell.first, rows).colwise().mean().transpose();
+    for (int a = 0; a < 2; ++a) {
+      if (!options_.vessel.periodic(a)) continue;
+      const double shift = period[a] * std::floor(centre[a] / period[a] + 0.5);  // into [-P/2, P/2)
+      if (shift != 0) X_.middleRows(cell.first, rows).col(a).array() -= shift;
+    }
+  }
+}
+
+}  // namespace bendlab::lbm
