@@ -1,0 +1,113 @@
+// Many cells in a tube: the case of HemoCell's pipeflow example (CELLS_IN_CHANNELS.md; issue
+// "Many cells in channel and tube flow"), one step of LbmSuspension and its parts.
+//   ./build/release/bench_suspension
+//
+// Tube 25 um across and 50 um long at dx = 0.5 um (D = 50 dx, 100 x 54 x 54 nodes, TRT, body force
+// for a pseudo-shear rate of 100 1/s at tau = 1), 36 red blood cells of 1280 triangles (Method C,
+// Skalak, the physical defaults of flow/cell_kind.hpp) and 6 small stiff spheres (radius 1.5 um, 320
+// triangles, ten times the shear modulus), placed from seed 1 with a clearance of 0.25 um; every
+// force is updated every step (HemoCell updates membrane forces every 20 steps and positions every
+// 5). Benchmarks (argument: OpenMP threads):
+//   BM_PipeflowStep      one whole step: steps_per_second is the figure to set against HemoCell's
+//                        26 (1 rank) and 48 (2 ranks) steps/s on this kind of machine;
+//   BM_PipeflowFluid     the fluid step alone (the same lattice, no cells): cells_fraction of the
+//                        whole step = 1 - fluid / step, computed by scripts from the two.
+#include <benchmark/benchmark.h>
+#include <omp.h>
+
+#include <memory>
+
+#include "bendlab/flow/cell_kind.hpp"
+#include "bendlab/flow/lbm/lbm_suspension.hpp"
+#include "bendlab/flow/lbm/physical_units.hpp"
+#include "bendlab/suspension/placement.hpp"
+
+using namespace bendlab;
+using namespace bendlab::lbm;
+
+namespace {
+
+FlowUnits pipeflow_units() {
+  FlowUnitsInput in;
+  in.geometry = FlowGeometry::Tube;
+  in.diameter_um = 25;
+  in.length_um = 50;
+  in.dx_um = 0.5;
+  in.tau = 1.0;
+  in.pseudo_shear_rate = 100;
+  return flow_units(in);
+}
+
+std::unique_ptr<LbmSuspension> pipeflow(bool with_cells) {
+  const FlowUnits u = pipeflow_units();
+  SuspensionOptions o;
+  o.lattice = flow_lattice_config(u);
+  o.vessel = Vessel::tube(u.section_lattice, u.nx);
+  const double cutoff = 1.0;
+  o.cell_contact = ContactLaw{u.to_lattice_force(1e-12), cutoff};
+  o.wall_contact = ContactLaw{u.to_lattice_force(1e-12), cutoff};
+  auto s = std::make_unique<LbmSuspension>(o);
+  if (!with_cells) return s;
+  const CellKind rbc = make_cell_kind(CellKindSpec{});
+  CellKindSpec small;
+  small.shape = "sphere";
+  small.radius_um = 1.5;
+  small.mesh = "mt1:320";
+  small.shear_modulus = 10 * 5.3e-6;
+  const CellKind stiff = make_cell_kind(small);
+  const Vessel tube_um = Vessel::tube(25, 50);
+  PlacementOptions p;
+  p.count = 36;
+  p.clearance = 0.25;
+  p.seed = 1;
+  const Placement reds = place_cells(tube_um, rbc.reference_um.topology(), rbc.reference_um.positions(), p);
+  const auto red_membrane = lattice_membrane(rbc, u);
+  const auto stiff_membrane = lattice_membrane(stiff, u);
+  for (const PlacedCell& c : reds.cells) s->add_cell(red_membrane, placed_positions(rbc.reference_um.positions(), c) / u.input.dx_um);
+  // The small cells where the red ones leave room: placed among them by trying positions.
+  int added = 0;
+  for (int k = 0; k < 400 && added < 6; ++k) {
+    PlacedCell c;
+    c.centre = Vec3(-25.0 + 50.0 * ((k * 37) % 100) / 100.0, 9.0 * std::cos(k), 9.0 * std::sin(k));
+    const Points x = placed_positions(stiff.reference_um.positions(), c) / u.input.dx_um;
+    bool clear = true;
+    for (Eigen::Index i = 0; i < x.rows() && clear; ++i) {
+      for (Eigen::Index j = 0; j < s->positions().rows() && clear; ++j) {
+        Vec3 d = row(x, i) - row(s->positions(), j);
+        d.x() -= u.nx * std::round(d.x() / u.nx);
+        clear = d.norm() > 1.0;
+      }
+    }
+    if (clear) {
+      s->add_cell(stiff_membrane, x);
+      ++added;
+    }
+  }
+  return s;
+}
+
+void BM_PipeflowStep(benchmark::State& state) {
+  omp_set_num_threads(static_cast<int>(state.range(0)));
+  static std::unique_ptr<LbmSuspension> s = pipeflow(true);
+  s->run(2);
+  for (auto _ : state) s->step();
+  state.counters["steps_per_second"] = benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["cells"] = s->num_cells();
+  state.counters["vertices"] = static_cast<double>(s->positions().rows());
+}
+
+void BM_PipeflowFluid(benchmark::State& state) {
+  omp_set_num_threads(static_cast<int>(state.range(0)));
+  static std::unique_ptr<LbmSuspension> s = pipeflow(false);
+  s->run(2);
+  for (auto _ : state) s->step();
+  state.counters["steps_per_second"] = benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["MLUPS"] = benchmark::Counter(static_cast<double>(state.iterations()) * s->lattice().num_fluid_nodes() * 1e-6,
+                                               benchmark::Counter::kIsRate);
+}
+
+}  // namespace
+
+BENCHMARK(BM_PipeflowFluid)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_PipeflowStep)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK_MAIN();
