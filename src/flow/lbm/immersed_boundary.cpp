@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 
 namespace bendlab::lbm {
@@ -115,6 +116,36 @@ void interpolate_velocity(const Lattice& lattice, const Points& X, Points& U, Ib
     }
   }
   if (failed) throw Error(message);
+}
+
+void IbInterpolator::interpolate(const Lattice& lattice, const Points& X, Points& U, IbKernel kernel) {
+  const std::size_t n = lattice.num_nodes();
+  if (stamp_.size() != n) {
+    stamp_.assign(n, 0);
+    velocity_.assign(3 * n, 0.0);
+    current_ = 0;
+  }
+  if (++current_ == 0) {  // the stamps wrapped around: start afresh
+    std::fill(stamp_.begin(), stamp_.end(), 0);
+    current_ = 1;
+  }
+  U.resize(X.rows(), 3);
+  for (Eigen::Index k = 0; k < X.rows(); ++k) {
+    const IbStencil st = ib_stencil(lattice, row(X, k), kernel);
+    Vec3 u = Vec3::Zero();
+    for (int s = 0; s < st.size; ++s) {
+      if (st.weight[s] == 0.0) continue;
+      const std::size_t node = st.node[s];
+      double* v = velocity_.data() + 3 * node;
+      if (stamp_[node] != current_) {
+        const Vec3 w = lattice.velocity(node);
+        v[0] = w.x(), v[1] = w.y(), v[2] = w.z();
+        stamp_[node] = current_;
+      }
+      u += st.weight[s] * Vec3(v[0], v[1], v[2]);
+    }
+    U.row(k) = u.transpose();
+  }
 }
 
 void euler_move(Points& X, const Points& U, double dt) {

@@ -60,8 +60,12 @@ void LbmSuspension::step() {
     if (options_.wall_contact.max_force > 0 && options_.vessel.kind() != VesselKind::Box) {
       wall_contact_energy_ = add_wall_contact(options_.vessel, options_.wall_contact, X_, F_);
     }
-    // 2-4.
-    ib_step(lattice_, X_, F_, U_, options_.kernel);
+    // 2-4, with the node velocities shared between overlapping stencils.
+    lattice_.clear_force();
+    spread_forces(lattice_, X_, F_, options_.kernel);
+    lattice_.step();
+    interpolator_.interpolate(lattice_, X_, U_, options_.kernel);
+    euler_move(X_, U_, 1.0);
   } catch (const Error& e) {
     throw Error(fmt::format("suspension step {}: {}", n, e.what()));
   }

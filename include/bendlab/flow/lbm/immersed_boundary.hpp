@@ -15,6 +15,8 @@
 // (4) interpolate from the post-stream populations with +F/2 of the same force and move the nodes.
 #include <array>
 #include <cstddef>
+#include <cstdint>
+#include <vector>
 
 #include "bendlab/core/types.hpp"
 #include "bendlab/flow/lbm/lattice.hpp"
@@ -49,6 +51,21 @@ IbStencil ib_stencil(const std::array<int, 3>& n, bool walls, const Vec3& X, IbK
 void spread_forces(Lattice& lattice, const Points& X, const Points& F, IbKernel kernel = IbKernel::Phi2);
 /// U (resized to N x 3) = sum_x u(x) Phi(x - X_k), u = (sum f c + F/2) / rho.
 void interpolate_velocity(const Lattice& lattice, const Points& X, Points& U, IbKernel kernel = IbKernel::Phi2);
+/// interpolate_velocity for many nodes whose stencils overlap (the vertices of many cells): the
+/// fluid velocity of each lattice node is computed once per call and shared by every stencil that
+/// holds it, which a membrane with about one vertex per dx visits about four times. The sums are
+/// taken in the same order as interpolate_velocity's, so U equals its result bit for bit. Keeps a
+/// stamp and a velocity per lattice node (28 bytes) between calls; not for concurrent use.
+class IbInterpolator {
+ public:
+  void interpolate(const Lattice& lattice, const Points& X, Points& U, IbKernel kernel = IbKernel::Phi2);
+
+ private:
+  std::vector<std::uint32_t> stamp_;
+  std::vector<double> velocity_;  // 3 per node
+  std::uint32_t current_ = 0;
+};
+
 /// X <- X + dt U.
 void euler_move(Points& X, const Points& U, double dt = 1.0);
 

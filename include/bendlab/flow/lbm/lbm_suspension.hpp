@@ -86,6 +86,7 @@ class LbmSuspension {
   std::vector<int> cell_of_;
   Points X_, F_, U_, scratch_x_, scratch_f_;
   ContactSearch contact_;
+  IbInterpolator interpolator_;
   double cell_contact_energy_ = 0, wall_contact_energy_ = 0;
 };
 
