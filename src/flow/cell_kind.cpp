@@ -59,6 +59,14 @@ CellKind make_cell_kind(const CellKindSpec& spec) {
   return kind;
 }
 
+std::optional<std::string> mesh_leak_warning(const CellKind& kind, double dx_um, double max_ratio) {
+  const double ratio = kind.mean_edge_um / dx_um;
+  if (ratio <= max_ratio) return std::nullopt;
+  return fmt::format("warning: the {} mesh '{}' has edges of {:.3g} um on average, {:.2g} times dx = {} um: fluid leaks "
+                     "through a membrane whose vertices lie more than about {} dx apart (use a finer mesh or a larger dx)",
+                     kind.spec.shape, kind.spec.mesh, kind.mean_edge_um, ratio, dx_um, max_ratio);
+}
+
 std::shared_ptr<const MembraneModel> lattice_membrane(const CellKind& kind, const lbm::FlowUnits& units) {
   const CellKindSpec& s = kind.spec;
   MembraneParameters p;

@@ -3,6 +3,8 @@
 // section 2) and its membrane in lattice units against the unit conversions.
 #include <gtest/gtest.h>
 
+#include <fmt/format.h>
+
 #include <cmath>
 
 #include "bendlab/flow/cell_kind.hpp"
@@ -68,4 +70,14 @@ TEST(CellKind, RefusesBadParameters) {
   s = CellKindSpec{};
   s.radius_um = 0;
   EXPECT_THROW(check_cell_kind(s), Error);
+}
+
+TEST(CellKind, WarnsOfAMeshTooCoarseForTheLattice) {
+  CellKindSpec spec;
+  spec.mesh = "mt1:320";  // edges of about 0.9 um
+  const CellKind coarse = make_cell_kind(spec);
+  const auto w = mesh_leak_warning(coarse, 0.25);
+  ASSERT_TRUE(w.has_value());
+  EXPECT_NE(w->find(fmt::format("{:.2g} times", coarse.mean_edge_um / 0.25)), std::string::npos) << *w;
+  EXPECT_FALSE(mesh_leak_warning(coarse, 1.0).has_value());
 }

@@ -9,6 +9,7 @@
 // Every cell of a kind shares its topology, reference shape and bending method: per cell a run
 // keeps positions and forces only.
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -45,6 +46,11 @@ struct CellKind {
 };
 
 CellKind make_cell_kind(const CellKindSpec& spec);
+
+/// A warning (one line, with the ratio) when the kind's mean edge is longer than `max_ratio` times
+/// dx: the immersed boundary then lets fluid leak through the membrane between the vertices
+/// (shared/spec/LBM_IBM.md section 3: edges of at most 1-1.5 dx). Nothing otherwise.
+std::optional<std::string> mesh_leak_warning(const CellKind& kind, double dx_um, double max_ratio = 1.5);
 
 /// The membrane of a kind in lattice units (positions in dx, moduli by FlowUnits), sharing the
 /// kind's topology and one bending method.
