@@ -323,8 +323,15 @@ inline const double* aligned64(const double* p) { return aligned64(const_cast<do
 }  // namespace
 
 BelkinLaplacian::BelkinLaplacian(const Topology& topology, const Points& x, const MeshGeometry& geometry,
-                                 BelkinOptions options)
-    : options_(options), n_(topology.num_vertices()) {
+                                 BelkinOptions options) {
+  prepare(topology, x, geometry, options);
+}
+
+void BelkinLaplacian::prepare(const Topology& topology, const Points& x, const MeshGeometry& geometry,
+                              BelkinOptions options) {
+  options_ = options;
+  n_ = topology.num_vertices();
+  has_weights_ = false;
   const Vec3 c = volume_centroid(topology, x);
   qx_.resize(n_);
   qy_.resize(n_);
@@ -358,7 +365,7 @@ BelkinLaplacian::BelkinLaplacian(const Topology& topology, const Points& x, cons
     max_exponent_ = kMaxExponent;
     order_.resize(n_);
     for (int p = 0; p < n_; ++p) order_[p] = p;
-    runs_ = {0, n_};
+    runs_.assign({0, n_});
     run_shared_ = true;
   }
   double* arrays = aligned64(points_.data());
@@ -383,7 +390,8 @@ BelkinLaplacian::~BelkinLaplacian() {
 void BelkinLaplacian::cache_weights() {
   const GridKernels& kernels = grid_kernels();
   const int lanes = kernels.lanes;
-  std::vector<std::size_t> start(static_cast<std::size_t>(n_) + 1, 0);
+  std::vector<std::size_t>& start = weight_start_;
+  start.assign(static_cast<std::size_t>(n_) + 1, 0);
   for (int i = 0; i < n_; ++i) {
     std::size_t count = 0;
     for (int r = run_start_[i]; r < run_start_[i + 1]; r += 2)
@@ -391,16 +399,19 @@ void BelkinLaplacian::cache_weights() {
     start[i + 1] = start[i] + count;
   }
   if (start[n_] > options_.weight_cache_bytes / sizeof(double)) return;
-  weight_start_ = std::move(start);
-  // Not zeroed: the pass below writes every entry before any apply reads it.
+  // Not zeroed: the pass below writes every entry before any apply reads it. The buffer of the
+  // previous shape when it is large enough, else this thread's spare, else a new one.
   const std::size_t need = std::max<std::size_t>(weight_start_[n_], 1);
-  if (spare_weights.capacity >= need) {
-    weights_.data = std::move(spare_weights.data);
-    weights_.capacity = std::exchange(spare_weights.capacity, 0);
-  } else {
-    weights_.data.reset(new double[need]);
-    weights_.capacity = need;
+  if (weights_.capacity < need) {
+    if (spare_weights.capacity >= need) {
+      weights_.data = std::move(spare_weights.data);
+      weights_.capacity = std::exchange(spare_weights.capacity, 0);
+    } else {
+      weights_.data.reset(new double[need]);
+      weights_.capacity = need;
+    }
   }
+  has_weights_ = true;
   GridInput in = grid_input(point_array(0), point_array(1), point_array(2), point_array(3), point_array(4), nullptr,
                             max_exponent_);
   lap_positions_.resize(n_, 3);
@@ -429,9 +440,12 @@ void BelkinLaplacian::build_grid() {
   // 800 at 0.5, about 440 inside the ball) but make more, shorter runs, and more rows to list.
   // Shorter cells along x only trim the ends of the runs, at no cost in rows (measured: the two
   // applies 4 to 15 % faster than with cubic cells; 0.35 across measured best among 0.3 to 0.6).
-  std::vector<double> r(n_);
+  GridBuffers& gb = grid_buffers_;
+  std::vector<double>& r = gb.radius;
+  r.resize(n_);
   for (int i = 0; i < n_; ++i) r[i] = std::sqrt(4.0 * kernel_area_[i] * max_exponent_);
-  std::vector<double> sorted = r;
+  std::vector<double>& sorted = gb.sorted;
+  sorted.assign(r.begin(), r.end());
   std::nth_element(sorted.begin(), sorted.begin() + n_ / 2, sorted.end());
   double cell = 0.35 * sorted[n_ / 2];
   double hi[3];
@@ -455,14 +469,18 @@ void BelkinLaplacian::build_grid() {
   for (int d = 0; d < 3; ++d) dims_[d] = static_cast<int>(std::floor((hi[d] - lo_[d]) / cell_[d])) + 1;
   auto coord = [&](double v, int d) { return std::clamp(static_cast<int>(std::floor((v - lo_[d]) / cell_[d])), 0, dims_[d] - 1); };
   const int ncells = dims_[0] * dims_[1] * dims_[2];
-  std::vector<int> cell_of(n_), cell_start(ncells + 1, 0);
+  std::vector<int>& cell_of = gb.cell_of;
+  std::vector<int>& cell_start = gb.cell_start;
+  cell_of.resize(n_);
+  cell_start.assign(ncells + 1, 0);
   for (int p = 0; p < n_; ++p) {
     cell_of[p] = (coord(qz_[p], 2) * dims_[1] + coord(qy_[p], 1)) * dims_[0] + coord(qx_[p], 0);
     ++cell_start[cell_of[p] + 1];
   }
   for (int c = 0; c < ncells; ++c) cell_start[c + 1] += cell_start[c];
   order_.resize(n_);
-  std::vector<int> fill(cell_start.begin(), cell_start.end() - 1);
+  std::vector<int>& fill = gb.fill;
+  fill.assign(cell_start.begin(), cell_start.end() - 1);
   for (int p = 0; p < n_; ++p) order_[fill[cell_of[p]]++] = p;  // stable: ascending p in a cell
   // The half-space test is needed only where the ball crosses the plane: for |p - x_i| <= r_i,
   // (p - c).(x_i - c) >= |x_i - c| (|x_i - c| - r_i) and |p - c| <= |x_i - c| + r_i, so every
@@ -482,7 +500,9 @@ void BelkinLaplacian::build_grid() {
   const double inv_cell[3] = {1.0 / cell_[0], 1.0 / cell_[1], 1.0 / cell_[2]};
   auto cell_index = [&](double v, int d) { return static_cast<int>((v - lo_[d]) * inv_cell[d]); };
   run_start_.assign(n_ + 1, 0);
-  std::vector<std::vector<int>> parts(omp_get_max_threads());
+  std::vector<std::vector<int>>& parts = gb.parts;
+  parts.resize(omp_get_max_threads());
+  for (std::vector<int>& part : parts) part.clear();
 #pragma omp parallel
   {
     const int threads = omp_get_num_threads(), t = omp_get_thread_num();
@@ -527,23 +547,21 @@ void BelkinLaplacian::build_grid() {
   }
   // Joined: vertex i's runs at [run_start_[i], run_start_[i + 1]).
   for (int i = 0; i < n_; ++i) run_start_[i + 1] += run_start_[i];
-  if (parts.size() == 1) {
-    runs_ = std::move(parts[0]);
-  } else {
-    runs_.clear();
-    runs_.reserve(run_start_[n_]);
-    for (const std::vector<int>& part : parts) runs_.insert(runs_.end(), part.begin(), part.end());
-  }
+  // Copied (a few MB, a fraction of a percent of the applies), not moved: both buffers stay for
+  // the next shape.
+  runs_.clear();
+  runs_.reserve(run_start_[n_]);
+  for (const std::vector<int>& part : parts) runs_.insert(runs_.end(), part.begin(), part.end());
   run_shared_ = false;
 }
 
 // The reference form (run_sum_body): for every vertex i, the sum of eq. (13) over all points.
 template <int Cols>
-void BelkinLaplacian::apply_columns(const double* const* w, double* const* out) const {
+void BelkinLaplacian::apply_columns(const double* const* w, double* const* out, std::vector<double>& ws) const {
   // The fields in the points' (scan) order, so that a run reads contiguous memory.
   // Each column padded by kLanes zeros (the kernel reads whole blocks).
   const std::size_t stride = static_cast<std::size_t>(n_) + kLanes;
-  std::vector<double> ws(static_cast<std::size_t>(Cols) * stride, 0.0);
+  ws.assign(static_cast<std::size_t>(Cols) * stride, 0.0);
   for (int col = 0; col < Cols; ++col)
     for (int k = 0; k < n_; ++k) ws[col * stride + k] = w[col][order_[k]];
   KernelInput in{};
@@ -571,15 +589,15 @@ void BelkinLaplacian::apply_columns(const double* const* w, double* const* out) 
 }
 
 // The grid form (grid_sum_body): w a scalar field (out[0]), or null for Lap x (out[0..2]).
-void BelkinLaplacian::apply_grid(const double* w, double* const* out) const {
+void BelkinLaplacian::apply_grid(const double* w, double* const* out, std::vector<double>& buffer) const {
   // The field in the points' (scan) order, 64-byte aligned, padded by zeros.
-  std::vector<double> buffer(w ? n_ + kLanes + 8 : 0, 0.0);
+  buffer.assign(w ? n_ + kLanes + 8 : 0, 0.0);
   double* ws = w ? aligned64(buffer.data()) : nullptr;
   for (int k = 0; w && k < n_; ++k) ws[k] = w[order_[k]];
   GridInput in = grid_input(point_array(0), point_array(1), point_array(2), point_array(3), point_array(4), ws,
                             max_exponent_);
   const GridKernels& kernels = grid_kernels();
-  const double* weights = weights_.data.get();
+  const double* weights = has_weights_ ? weights_.data.get() : nullptr;
 #pragma omp parallel for schedule(dynamic, 64) firstprivate(in)
   for (int i = 0; i < n_; ++i) {
     set_vertex(in, qx_[i], qy_[i], qz_[i], qnorm_[i], kernel_area_[i], w ? w[i] : 0.0);
@@ -596,33 +614,66 @@ void BelkinLaplacian::apply_grid(const double* w, double* const* out) const {
   }
 }
 
+namespace {
+void check_field_size(Eigen::Index size, int n, const char* what) {
+  if (size != n)
+    throw Error("belkin_laplacian: field has " + std::to_string(size) + " " + what + ", mesh has " + std::to_string(n) +
+                " vertices");
+}
+}  // namespace
+
 Scalars BelkinLaplacian::apply(const Scalars& w) const {
-  if (w.size() != n_) throw Error("belkin_laplacian: field has " + std::to_string(w.size()) + " values, mesh has " +
-                                  std::to_string(n_) + " vertices");
+  check_field_size(w.size(), n_, "values");
   Scalars out(n_);
+  std::vector<double> buffer;
   const double* in[1] = {w.data()};
   double* res[1] = {out.data()};
   if (run_shared_)
-    apply_columns<1>(in, res);
+    apply_columns<1>(in, res, buffer);
   else
-    apply_grid(w.data(), res);
+    apply_grid(w.data(), res, buffer);
   return out;
 }
 
+void BelkinLaplacian::apply_into(const Scalars& w, Scalars& out) {
+  check_field_size(w.size(), n_, "values");
+  out.resize(n_);
+  const double* in[1] = {w.data()};
+  double* res[1] = {out.data()};
+  if (run_shared_)
+    apply_columns<1>(in, res, field_buffer_);
+  else
+    apply_grid(w.data(), res, field_buffer_);
+}
+
 Points BelkinLaplacian::apply(const Points& w) const {
-  if (w.rows() != n_) throw Error("belkin_laplacian: field has " + std::to_string(w.rows()) + " rows, mesh has " +
-                                  std::to_string(n_) + " vertices");
+  check_field_size(w.rows(), n_, "rows");
   // Column-major copies so that the inner loop over p reads contiguous memory.
   const Eigen::MatrixXd wc = w;
   Eigen::MatrixXd oc(n_, 3);
+  std::vector<double> buffer;
   const double* in[3] = {wc.col(0).data(), wc.col(1).data(), wc.col(2).data()};
   double* res[3] = {oc.col(0).data(), oc.col(1).data(), oc.col(2).data()};
   if (run_shared_) {
-    apply_columns<3>(in, res);
+    apply_columns<3>(in, res, buffer);
   } else {
-    for (int col = 0; col < 3; ++col) apply_grid(in[col], res + col);
+    for (int col = 0; col < 3; ++col) apply_grid(in[col], res + col, buffer);
   }
   return oc;
+}
+
+void BelkinLaplacian::apply_into(const Points& w, Points& out) {
+  check_field_size(w.rows(), n_, "rows");
+  columns_in_ = w;
+  columns_out_.resize(n_, 3);
+  const double* in[3] = {columns_in_.col(0).data(), columns_in_.col(1).data(), columns_in_.col(2).data()};
+  double* res[3] = {columns_out_.col(0).data(), columns_out_.col(1).data(), columns_out_.col(2).data()};
+  if (run_shared_) {
+    apply_columns<3>(in, res, field_buffer_);
+  } else {
+    for (int col = 0; col < 3; ++col) apply_grid(in[col], res + col, field_buffer_);
+  }
+  out = columns_out_;
 }
 
 Points BelkinLaplacian::apply_to_positions() const {
@@ -631,11 +682,29 @@ Points BelkinLaplacian::apply_to_positions() const {
     for (int p = 0; p < n_; ++p) q.row(p) = Eigen::RowVector3d(qx_[p], qy_[p], qz_[p]);
     return apply(q);
   }
-  if (weights_.data) return lap_positions_;  // computed with the weights
+  if (has_weights_) return lap_positions_;  // computed with the weights
   Eigen::MatrixXd oc(n_, 3);
+  std::vector<double> buffer;
   double* res[3] = {oc.col(0).data(), oc.col(1).data(), oc.col(2).data()};
-  apply_grid(nullptr, res);
+  apply_grid(nullptr, res, buffer);
   return oc;
+}
+
+void BelkinLaplacian::apply_to_positions_into(Points& out) {
+  if (run_shared_) {
+    positions_buffer_.resize(n_, 3);
+    for (int p = 0; p < n_; ++p) positions_buffer_.row(p) = Eigen::RowVector3d(qx_[p], qy_[p], qz_[p]);
+    apply_into(positions_buffer_, out);
+    return;
+  }
+  if (has_weights_) {
+    out = lap_positions_;  // computed with the weights
+    return;
+  }
+  columns_out_.resize(n_, 3);
+  double* res[3] = {columns_out_.col(0).data(), columns_out_.col(1).data(), columns_out_.col(2).data()};
+  apply_grid(nullptr, res, field_buffer_);
+  out = columns_out_;
 }
 
 Scalars belkin_laplacian(const Topology& topology, const Points& x, const MeshGeometry& geometry, const Scalars& w,
@@ -672,23 +741,36 @@ MethodInfo BelkinMethod::info() {
   return m;
 }
 
-BendingResult BelkinMethod::compute(const Topology& topology, const Points& x, double kappa_b) const {
-  return compute_terms(topology, x, BendingParameters(kappa_b));  // plain: eq. (10) unchanged
-}
+// Kept by the method instance and reused from call to call (method_workspace.hpp).
+struct BelkinMethod::Workspace {
+  MeshGeometry geometry;
+  BelkinLaplacian laplacian;
+  Points lap_x;
+};
 
-// With c0 and ADE the force law of docs/conventions.md §5 from the same H, K, Lap H and n.
-BendingResult BelkinMethod::compute_terms(const Topology& topology, const Points& x,
-                                          const BendingParameters& params) const {
-  const MeshGeometry g = MeshGeometry::compute(topology, x);
-  const BelkinLaplacian lap(topology, x, g, options_);
+BelkinMethod::BelkinMethod(BelkinOptions options) : options_(options) {}
+BelkinMethod::~BelkinMethod() = default;
+
+void BelkinMethod::fields(const Topology& topology, const Points& x, BendingResult& out) const {
+  const auto ws = workspace_.acquire();
+  MeshGeometry& g = ws->geometry;
+  MeshGeometry::compute(topology, x, g);
+  BelkinLaplacian& lap = ws->laplacian;
+  lap.prepare(topology, x, g, options_);
   // eq. (2) with eq. (13): Lap x = -2 H n.
   // The reference applies the operator to x itself (the grid form: to x - c, the same up to rounding).
-  const Points lap_x = options_.neighbours == BelkinOptions::Neighbours::all ? lap.apply(x) : lap.apply_to_positions();
-  Scalars H(topology.num_vertices());
-  for (int i = 0; i < topology.num_vertices(); ++i) H[i] = -0.5 * lap_x.row(i).dot(g.normal_mwa.row(i));
-  Scalars lapH = lap.apply(H);  // eq. (13) applied to H
-  return assemble_variational_result(g.normal_mwa, std::move(H), g.gaussian_curvature, std::move(lapH),
-                                     g.mixed_area, params);
+  Points& lap_x = ws->lap_x;
+  if (options_.neighbours == BelkinOptions::Neighbours::all)
+    lap.apply_into(x, lap_x);
+  else
+    lap.apply_to_positions_into(lap_x);
+  out.H.resize(topology.num_vertices());
+  for (int i = 0; i < topology.num_vertices(); ++i) out.H[i] = -0.5 * lap_x.row(i).dot(g.normal_mwa.row(i));
+  lap.apply_into(out.H, out.lapH);  // eq. (13) applied to H
+  // The geometry's arrays change places with the result's (no copy; next call they are reused).
+  out.normal.swap(g.normal_mwa);
+  out.K.swap(g.gaussian_curvature);
+  out.area.swap(g.mixed_area);
 }
 
 }  // namespace bendlab

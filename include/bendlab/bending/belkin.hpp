@@ -86,6 +86,7 @@
 #include <vector>
 
 #include "bendlab/bending/method_registry.hpp"
+#include "bendlab/bending/variational_assembly.hpp"
 #include "bendlab/geometry/mesh_geometry.hpp"
 
 namespace bendlab {
@@ -123,6 +124,8 @@ Points belkin_laplacian(const Topology& topology, const Points& x, const MeshGeo
 /// for the grid form, the cell list) and applied to several fields, as Method D does to x and H.
 class BelkinLaplacian {
  public:
+  /// An operator for no shape yet (prepare() gives it one).
+  BelkinLaplacian() = default;
   BelkinLaplacian(const Topology& topology, const Points& x, const MeshGeometry& geometry,
                   BelkinOptions options = {});
   /// Hands the weights' memory to a spare kept per thread, which the next operator built on that
@@ -130,18 +133,26 @@ class BelkinLaplacian {
   ~BelkinLaplacian();
   BelkinLaplacian(BelkinLaplacian&&) = default;
   BelkinLaplacian& operator=(BelkinLaplacian&&) = default;
+  /// The operator of another shape (what the constructor does), in this operator's buffers: no
+  /// allocation once they are large enough (a method keeps its operator from call to call).
+  void prepare(const Topology& topology, const Points& x, const MeshGeometry& geometry, BelkinOptions options = {});
   Scalars apply(const Scalars& w) const;
   Points apply(const Points& w) const;
   /// Lap x: the operator applied to the positions it was built from (equal to apply(x) up to
   /// rounding; the grid form reuses the differences p - x_i its kernel computes anyway).
   Points apply_to_positions() const;
+  /// The same three into `out` (resized), with the operator's own scratch buffers: the same values,
+  /// no allocation once warm, but not for concurrent use of one operator (apply() is).
+  void apply_into(const Scalars& w, Scalars& out);
+  void apply_into(const Points& w, Points& out);
+  void apply_to_positions_into(Points& out);
   /// Lumped weight of vertex p: one third of the area of the faces at p.
   const Scalars& lumped_area() const { return lumped_area_; }
 
  private:
   template <int Cols>
-  void apply_columns(const double* const* w, double* const* out) const;
-  void apply_grid(const double* w, double* const* out) const;
+  void apply_columns(const double* const* w, double* const* out, std::vector<double>& buffer) const;
+  void apply_grid(const double* w, double* const* out, std::vector<double>& buffer) const;
   void build_grid();
   void cache_weights();
   /// Array j of the points in scan order (0, 1, 2: centred position; 3: |x_p - c|; 4: lumped
@@ -170,24 +181,39 @@ class BelkinLaplacian {
   /// Grid form: 1 where vertex i's ball crosses the half-space plane (the kernel tests each
   /// point), 0 where every point within its cut-off radius lies above it.
   std::vector<unsigned char> plane_test_;
-  /// Grid form, when they fit options.weight_cache_bytes (else null): the kernel weights
-  /// A_p exp(-|p - x_i|^2 / (4 a_i)) of every lane of every block vertex i scans (zero where a
-  /// term is dropped), from weight_start_[i], so that Lap x and Lap H evaluate each exponential once.
+  /// Grid form, when they fit options.weight_cache_bytes (else has_weights_ is false): the kernel
+  /// weights A_p exp(-|p - x_i|^2 / (4 a_i)) of every lane of every block vertex i scans (zero
+  /// where a term is dropped), from weight_start_[i], so that Lap x and Lap H evaluate each
+  /// exponential once. The buffer is kept from shape to shape.
   struct WeightBuffer {
     std::unique_ptr<double[]> data;
     std::size_t capacity = 0;
   };
   WeightBuffer weights_;
+  bool has_weights_ = false;
   std::vector<std::size_t> weight_start_;
   /// Lap x, summed in the same pass as the weights (apply_to_positions() returns it then).
   Points lap_positions_;
+  /// build_grid's buffers, kept from shape to shape: cut-off radii, cell of each point, cell
+  /// starts, fill positions, each thread's runs.
+  struct GridBuffers {
+    std::vector<double> radius, sorted;
+    std::vector<int> cell_of, cell_start, fill;
+    std::vector<std::vector<int>> parts;
+  };
+  GridBuffers grid_buffers_;
+  /// The *_into functions' buffers: a field in scan order, column-major copies of a vector field.
+  std::vector<double> field_buffer_;
+  Eigen::MatrixXd columns_in_, columns_out_;
+  Points positions_buffer_;
 };
 
 /// Method D: normal = MWA; H by eq. (2) with eq. (13) (H = -1/2 (Lap x) . n); lapH by eq. (13)
 /// applied to H; K by eq. (12); f by eq. (10); F = f A_mixed (eq. (14)); no energy.
-class BelkinMethod final : public BendingMethod {
+class BelkinMethod final : public VariationalMethod {
  public:
-  explicit BelkinMethod(BelkinOptions options = {}) : options_(options) {}
+  explicit BelkinMethod(BelkinOptions options = {});
+  ~BelkinMethod() override;
   /// Options: "neighbours" = "grid" (default) | "all", "kernel_cutoff" = a number in [1e-300, 0.5]
   /// (default 1e-15); see BelkinOptions. Any other option is an error (bendlab::Error naming it).
   static std::unique_ptr<BendingMethod> create(const MethodOptions& options);
@@ -196,15 +222,16 @@ class BelkinMethod final : public BendingMethod {
   const BelkinOptions& options() const { return options_; }
 
   std::string name() const override { return "D"; }
-  BendingResult compute(const Topology& topology, const Points& x, double kappa_b) const override;
 
  protected:
-  /// c0 and ADE through the force law of docs/conventions.md §5 (variational_assembly.hpp).
-  bool supports_membrane_terms() const override { return true; }
-  BendingResult compute_terms(const Topology& topology, const Points& x, const BendingParameters& params) const override;
+  /// n, H, K, lapH and the mixed area; eq. (10) and c0 / ADE are VariationalMethod's.
+  void fields(const Topology& topology, const Points& x, BendingResult& out) const override;
 
  private:
   BelkinOptions options_;
+  struct Workspace;
+  /// The geometry, the operator (cell list, weights) and Lap x of the last call, kept between calls.
+  MethodWorkspace<Workspace> workspace_;
 };
 
 }  // namespace bendlab
