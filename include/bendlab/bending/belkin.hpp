@@ -12,7 +12,7 @@
 // volume centroid c whose normal points from c to x_i, i.e. (p - c).(x_i - c) > 0, take part, so
 // that nodes close in space but far along the surface (the two dimples of a red blood cell) do not
 // see each other. Points within a relative margin of 1e-9 of the plane count as on it (see
-// belkin.cpp), so that the rule does not depend on rounding for symmetric meshes.
+// belkin_kernel.hpp), so that the rule does not depend on rounding for symmetric meshes.
 //
 // Two evaluations of the same sum (BelkinOptions::neighbours, method option "neighbours"):
 //
@@ -42,7 +42,7 @@
 //   reference's exponential: 7.5e-12 at 81920; with cutoff 1e-12: 5.9e-9, too close to 1e-8.)
 //   Values below e^-80 are clamped to e^-80, the reference's own cut, so that both forms keep the
 //   same terms and differ only by the order of the sum and the exponential below.
-// Kernels (belkin.cpp), branch-free over blocks of points of a run (the exponent, the cut-off,
+// Kernels (belkin_kernel.hpp), branch-free over blocks of points of a run (the exponent, the cut-off,
 // the run's end and the half-space test as a mask) so that they vectorise (AVX-512, AVX2 or
 // baseline, chosen at run time):
 // - all: blocks of 16, exp by a polynomial within an ulp of std::exp (measured over [0, 80]).
@@ -82,6 +82,10 @@
 // Both are deterministic; they differ only by the order of the sum, the exponential and the
 // dropped terms.
 // The operator of a constant is exactly zero in both (every term carries w(p) - w(x_i) = 0).
+// Where the parts are: belkin_kernel.hpp/.cpp the per-vertex sums and their exponentials;
+// belkin_grid.cpp the cell list, the runs, the kept weights and the grid form's applies;
+// belkin_reference.cpp the all-pairs form; belkin.cpp the operator's set-up for a shape, the
+// dispatch of the applies and Method D.
 #include <memory>
 #include <vector>
 
