@@ -123,7 +123,7 @@ __attribute__((always_inline)) inline void grid_cached_body(const GridInput& in,
 }  // namespace
 
 // Compiled for AVX-512, AVX2+FMA and baseline x86-64 and picked at run time (as the boundary
-// integral's kernel, stokes_single_layer.cpp).
+// integral's kernels, stokeslet_sums.cpp).
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
 #define BENDLAB_KERNEL_CLONES __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
 #else
