@@ -18,6 +18,9 @@
 //                          benchmarks of P and Q follow each other: every method after every
 //                          other. Q's time should not depend on P (docs/benchmarks.md, "Order of the
 //                          methods"; the cause it guards against: bending/method_workspace.hpp).
+//                          On a shared machine run it with --benchmark_repetitions=3
+//                          --benchmark_enable_random_interleaving=true, so that a drift of the load
+//                          is not taken for an effect of the order.
 //   BM_MongeJetFit/<path>  Method M's fits alone (steps 3-5, METHOD_M.md) at every node of the RBC at
 //                          20480 triangles, one thread, on the 3-ring supports and covariance frames
 //                          the method uses: path lanes (monge_jet_fit_nodes, 8 nodes side by side in

@@ -10,7 +10,8 @@ With --section order, only the section "Order of the methods" of an existing --o
 again, from the BM_Order rows of <results>/bench_bending.json (and the load averages of
 <results>/machine.txt, if any), the rest of the document left as it is:
 
-    OMP_NUM_THREADS=1 ./build/release/bench_bending --benchmark_filter='BM_Order/' \
+    OMP_NUM_THREADS=1 ./build/release/bench_bending --benchmark_filter='BM_Order/' \\
+        --benchmark_repetitions=3 --benchmark_enable_random_interleaving=true \\
         --benchmark_format=json > results/order/bench_bending.json
     /usr/bin/python3 scripts/make_benchmarks_doc.py --section order --results results/order
 """
@@ -142,7 +143,21 @@ def order_section(bend, machine):
     for r in rows:
         if r["args"].get("after") not in before:
             before.append(r["args"].get("after"))
-    cell = {(r["variant"], r["args"].get("after")): r["b"] for r in rows}
+    # Every repetition of a pair (a report with --benchmark_repetitions has several rows per name).
+    cell = {}
+    for r in rows:
+        cell.setdefault((r["variant"], r["args"].get("after")), []).append(r["b"])
+    repetitions = max(len(v) for v in cell.values())
+
+    def median(values):
+        v = sorted(values)
+        return 0.5 * (v[(len(v) - 1) // 2] + v[len(v) // 2])
+
+    def cv(values):
+        if len(values) < 2:
+            return None
+        m = sum(values) / len(values)
+        return (sum((x - m) ** 2 for x in values) / (len(values) - 1)) ** 0.5 / m
     out = []
     w = out.append
     w(ORDER_HEADING)
@@ -163,19 +178,30 @@ def order_section(bend, machine):
     if ls or le:
         w(f"Load average (1, 5, 15 min) at the start: {ls or '-'}; at the end: {le or '-'} (2 cores).")
         w("")
-    w("Processor time of the benchmark's thread per call (ms), Q in rows, P in columns; spread = the")
-    w("largest over the smallest time of the row.")
+    if repetitions > 1:
+        w(f"Processor time of the benchmark's thread per call (ms), the median of {repetitions} repetitions")
+        w("run in random order (`--benchmark_enable_random_interleaving`, so that a drift of the")
+        w("machine's load over the run does not look like an effect of the order), Q in rows, P in")
+        w("columns; spread = the largest over the smallest median of the row; noise = the largest")
+        w("coefficient of variation of one pair's repetitions in the row, the machine's own scatter.")
+    else:
+        w("Processor time of the benchmark's thread per call (ms), Q in rows, P in columns; spread = the")
+        w("largest over the smallest time of the row (one run of each pair: run with repetitions, as the")
+        w("top of `scripts/make_benchmarks_doc.py` shows, to see the machine's own scatter).")
     w("")
-    w("| Q, after P: | " + " | ".join(before) + " | spread | page faults per call (max) |")
-    w("| --- | " + " | ".join("---" for _ in before) + " | --- | --- |")
+    w("| Q, after P: | " + " | ".join(before) + " | spread | noise | page faults per call (max) |")
+    w("| --- | " + " | ".join("---" for _ in before) + " | --- | --- | --- |")
     for q in methods:
-        times = [cpu_seconds(cell[(q, p)]) * 1e3 if (q, p) in cell else None for p in before]
-        faults = [cell[(q, p)].get("page_faults_per_call") for p in before if (q, p) in cell]
+        runs = [[cpu_seconds(b) * 1e3 for b in cell[(q, p)]] if (q, p) in cell else [] for p in before]
+        times = [median(t) if t else None for t in runs]
+        faults = [b.get("page_faults_per_call") for p in before for b in cell.get((q, p), [])]
         known = [t for t in times if t is not None]
         spread = f"{max(known) / min(known):.2f}" if known else "-"
+        cvs = [c for c in (cv(t) for t in runs) if c is not None]
+        noise = f"{max(cvs):.0%}" if cvs else "-"
         fmax = max((f for f in faults if f is not None), default=None)
         w(f"| {q} | " + " | ".join(f"{t:.4g}" if t is not None else "-" for t in times) +
-          f" | {spread} | {'-' if fmax is None else f'{fmax:.3g}'} |")
+          f" | {spread} | {noise} | {'-' if fmax is None else f'{fmax:.3g}'} |")
     w("")
     return out
 
@@ -185,7 +211,7 @@ def main():
     ap.add_argument("--results", default="results/bench")
     ap.add_argument("--out", default="docs/benchmarks.md")
     ap.add_argument("--section", choices=["order"],
-                    help="write only this section of an existing --out again (see the module's help)")
+                    help="write only this section of an existing --out again (see the top of this script)")
     a = ap.parse_args()
 
     if a.section == "order":

@@ -40,9 +40,9 @@ def test_section_inserted_before_the_last_one_and_the_rest_kept(tmp_path):
     text = run(tmp_path, times, doc)
     assert text.startswith("# Benchmarks\n\n## Bending\n\ntable\n\n## Order of the methods (`BM_Order`)")
     assert text.rstrip().endswith("## Running one benchmark\n\n    cmd")
-    assert "| Q, after P: | A | C | spread | page faults per call (max) |" in text
-    assert "| A | 12 | 13 | 1.08 | 0 |" in text
-    assert "| C | 8 | 9 | 1.13 | 2 |" in text
+    assert "| Q, after P: | A | C | spread | noise | page faults per call (max) |" in text
+    assert "| A | 12 | 13 | 1.08 | - | 0 |" in text
+    assert "| C | 8 | 9 | 1.13 | - | 2 |" in text
     assert "0.5 0.6 0.7" in text and "0.8 0.9 1.0" in text
 
 
@@ -52,4 +52,27 @@ def test_section_replaced_in_place(tmp_path):
     text = run(tmp_path, {("C", "C"): (9.0, 0.0)}, doc)
     assert "old table" not in text
     assert text.count("## Order of the methods") == 1
-    assert "| C | 9 | 1.00 | 0 |" in text
+    assert "| C | 9 | 1.00 | - | 0 |" in text
+
+
+def test_repetitions_give_medians_and_noise(tmp_path):
+    # Three repetitions of each pair (rows with the same name): the median in the cell, the
+    # largest coefficient of variation of a pair as the row's noise.
+    results = tmp_path / "results"
+    results.mkdir()
+    rows = []
+    for p, reps in (("A", (10.0, 11.0, 12.0)), ("C", (10.0, 10.0, 10.0))):
+        for cpu in reps:
+            rows.append({"name": f"BM_Order/C/after:{p}/iterations:5/real_time", "run_type": "iteration",
+                         "real_time": cpu, "cpu_time": cpu, "time_unit": "ms", "iterations": 5,
+                         "page_faults_per_call": 0.0})
+        rows.append({"name": f"BM_Order/C/after:{p}/iterations:5/real_time_mean", "run_type": "aggregate",
+                     "aggregate_name": "mean", "real_time": 11.0, "cpu_time": 11.0, "time_unit": "ms"})
+    (results / "bench_bending.json").write_text(json.dumps({"context": {}, "benchmarks": rows}))
+    out = tmp_path / "benchmarks.md"
+    out.write_text("# Benchmarks\n\n## Running one benchmark\n")
+    subprocess.run([sys.executable, str(SCRIPT), "--section", "order", "--results", str(results), "--out", str(out)],
+                   check=True)
+    text = out.read_text()
+    assert "the median of 3 repetitions" in text
+    assert "| C | 11 | 10 | 1.10 | 9% | 0 |" in text
