@@ -8,8 +8,8 @@ namespace bendlab {
 // Integral over the triangle (x0, x1, x2), singular at x0, of f(y) . G(y, x0) dS(y), f linear with
 // node values f0, f1, f2; polar coordinates about x0 (see the header).
 Vec3 singular_polar_integral(const Vec3& x0, const Vec3& x1, const Vec3& x2, const Vec3& f0, const Vec3& f1,
-                    const Vec3& f2, int subdivisions, const std::vector<double>& nodes,
-                    const std::vector<double>& weights) {
+                             const Vec3& f2, int subdivisions, const std::vector<double>& nodes,
+                             const std::vector<double>& weights) {
   const Vec3 a = x1 - x0, b = x2 - x0;
   const double la = a.norm();
   const Vec3 t1 = a / la;

@@ -1,3 +1,7 @@
+// The single layer's options, the 7-point points and weighted densities of an evaluation (faces
+// in Morton order for the adaptive and tree rules), and velocity(): each target's regular sum by
+// its rule, then its own triangles taken back and integrated in polar coordinates. Built with
+// -fno-math-errno -ffp-contract=fast (CMakeLists.txt), as every file of the single layer.
 #include "bendlab/flow/bim/stokes_single_layer.hpp"
 
 #include <fmt/format.h>

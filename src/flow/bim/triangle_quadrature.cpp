@@ -1,3 +1,5 @@
+// Built with -fno-math-errno -ffp-contract=fast (CMakeLists.txt), as the rest of the single layer:
+// the Gauss-Legendre nodes, found by Newton's iteration, are those of the fused arithmetic.
 #include "bendlab/flow/bim/triangle_quadrature.hpp"
 
 #include <fmt/format.h>
