@@ -135,6 +135,9 @@ def order_section(bend, machine):
     rows = [r for r in bend["rows"] if r["family"] == "BM_Order" and not r["error"]] if bend else []
     if not rows:
         return []
+    # In the order the pairs were registered (Q by Q, P by P: the registry's order of the methods),
+    # not the order they ran in, which random interleaving shuffles.
+    rows.sort(key=lambda r: r["b"].get("family_index", 0))
     methods = []
     for r in rows:
         if r["variant"] not in methods:
