@@ -4,28 +4,41 @@
 //   ./build/release/bench_bending --benchmark_filter='BM_Compute/C/'
 //
 // Benchmarks (arguments: triangles, OpenMP threads):
-//   BM_Compute/<method>    BendingMethod::compute (every per-vertex quantity), every registered method
-//                          (`bendlab methods`: A..E, ED, S)
+//   BM_Compute/<method>    BendingMethod::compute_into (every per-vertex quantity, into a result kept
+//                          from iteration to iteration, as a time loop keeps it), every registered
+//                          method (`bendlab methods`: A..E, ED, S, J, M)
 //   BM_Forces/<method>     BendingMethod::forces (node forces only: what a flow run calls) of every
 //                          method but the O(N^2) ones, at 5120, 20480 and 81920 triangles, alternating
 //                          between two nearby shapes. The ratio BM_Forces/S / BM_Forces/C is Method
 //                          S's cost relative to Method C (docs/design.md).
 //   BM_Compute/E_rings<R>  Method E with neighbourhoods of R = 2 and 3 rings, 5120 triangles (every
 //                          O(N) method with a "rings" option)
+//   BM_Order/<Q>/after:<P> Method Q's compute_into at 81920 triangles, one thread, right after an
+//                          instance of method P ran (3 calls) and was destroyed, as when the
+//                          benchmarks of P and Q follow each other: every method after every
+//                          other. Q's time should not depend on P (docs/benchmarks.md, "Order of the
+//                          methods"; the cause it guards against: bending/method_workspace.hpp).
+//                          On a shared machine run it with --benchmark_repetitions=3
+//                          --benchmark_enable_random_interleaving=true, so that a drift of the load
+//                          is not taken for an effect of the order.
 //   BM_MongeJetFit/<path>  Method M's fits alone (steps 3-5, METHOD_M.md) at every node of the RBC at
 //                          20480 triangles, one thread, on the 3-ring supports and covariance frames
 //                          the method uses: path lanes (monge_jet_fit_nodes, 8 nodes side by side in
 //                          SIMD lanes, the method's) or reference (monge_jet_fit_point, one node at a
 //                          time, Eigen's fixed-size Cholesky), at degrees 5 and 6.
 // Counters: vertices_per_s (vertices / wall-clock second) and vertices_per_s_per_thread (the same
-// divided by the OpenMP threads). Times are wall-clock (UseRealTime), since the work runs on
-// OpenMP threads.
+// divided by the OpenMP threads); page_faults_per_call (minor page faults of the process per timed
+// call, getrusage: memory the call touches for the first time since the kernel handed it out,
+// which a method that allocates nothing once warm does not cause). Times are wall-clock
+// (UseRealTime), since the work runs on OpenMP threads. Every benchmark makes two untimed calls
+// first (what a method sets up once per mesh, and its workspace).
 //
 // A method whose registry cost class is O(N^2) runs a single iteration at 81920 triangles and has
 // no BM_Forces row. Methods D and ED are O(N) (Belkin's heat kernel truncated at kernel_cutoff,
 // through a cell list, belkin.hpp); their O(N^2) reference form is timed by bench/belkin_neighbours.
 #include <benchmark/benchmark.h>
 #include <omp.h>
+#include <sys/resource.h>
 
 #include <cmath>
 #include <map>
@@ -65,17 +78,59 @@ void set_counters(benchmark::State& state, const TriMesh& mesh, int threads) {
                          benchmark::Counter::kIsIterationInvariantRate);
 }
 
+// Minor page faults of the process so far.
+long minor_faults() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return u.ru_minflt;
+}
+
+void set_fault_counter(benchmark::State& state, long faults) {
+  state.counters["page_faults_per_call"] =
+      benchmark::Counter(static_cast<double>(faults), benchmark::Counter::kAvgIterations);
+}
+
 void BM_Compute(benchmark::State& state, const std::string& method, const MethodOptions& options) {
   const TriMesh& mesh = rbc_mesh(static_cast<int>(state.range(0)));
   const int threads = static_cast<int>(state.range(1));
   omp_set_num_threads(threads);
   const auto m = make_bending_method(method, options);
+  BendingResult r;
+  // Untimed: the workspace; the second call lets the arrays the result and the workspace trade
+  // (method_workspace.hpp) settle.
+  for (int k = 0; k < 2; ++k) m->compute_into(mesh.topology(), mesh.positions(), 1.0, r);
+  const long faults = minor_faults();
   for (auto _ : state) {
-    BendingResult r = m->compute(mesh.topology(), mesh.positions(), 1.0);
+    m->compute_into(mesh.topology(), mesh.positions(), 1.0, r);
     benchmark::DoNotOptimize(r.force.data());
     benchmark::ClobberMemory();
   }
+  set_fault_counter(state, minor_faults() - faults);
   set_counters(state, mesh, threads);
+}
+
+// Method `method` right after an instance of `before` ran and was destroyed (BM_Order above).
+void BM_Order(benchmark::State& state, const std::string& method, const std::string& before) {
+  const TriMesh& mesh = rbc_mesh(81920);
+  omp_set_num_threads(1);
+  {
+    const auto p = make_bending_method(before);
+    BendingResult r;
+    for (int k = 0; k < 3; ++k) p->compute_into(mesh.topology(), mesh.positions(), 1.0, r);
+  }
+  const auto m = make_bending_method(method);
+  BendingResult r;
+  // Untimed: the workspace; the second call lets the arrays the result and the workspace trade
+  // (method_workspace.hpp) settle.
+  for (int k = 0; k < 2; ++k) m->compute_into(mesh.topology(), mesh.positions(), 1.0, r);
+  const long faults = minor_faults();
+  for (auto _ : state) {
+    m->compute_into(mesh.topology(), mesh.positions(), 1.0, r);
+    benchmark::DoNotOptimize(r.force.data());
+    benchmark::ClobberMemory();
+  }
+  set_fault_counter(state, minor_faults() - faults);
+  set_counters(state, mesh, 1);
 }
 
 void BM_Forces(benchmark::State& state, const std::string& method) {
@@ -94,11 +149,14 @@ void BM_Forces(benchmark::State& state, const std::string& method) {
   // Untimed: what a method sets up once per topology (S: patches, factorisation of L, mass pattern), as a
   // flow run pays it once.
   m->forces(mesh.topology(), moved, 1.0, force);
+  m->forces(mesh.topology(), mesh.positions(), 1.0, force);
+  const long faults = minor_faults();
   for (auto _ : state) {
     m->forces(mesh.topology(), *shapes[k ^= 1], 1.0, force);
     benchmark::DoNotOptimize(force.data());
     benchmark::ClobberMemory();
   }
+  set_fault_counter(state, minor_faults() - faults);
   set_counters(state, mesh, threads);
 }
 
@@ -150,6 +208,14 @@ void register_all() {
     auto* b = benchmark::RegisterBenchmark(("BM_Forces/" + method).c_str(), BM_Forces, method);
     b->ArgsProduct({{5120, 20480, 81920}, {1, 2}})->ArgNames({"triangles", "threads"})->UseRealTime()
         ->Unit(benchmark::kMillisecond);
+  }
+  // Every method after every other, 81920 triangles, one thread. A fixed count of calls keeps the
+  // 81 pairs to about a minute on the reference machine.
+  for (const std::string& q : bending_method_names()) {
+    for (const std::string& p : bending_method_names()) {
+      auto* b = benchmark::RegisterBenchmark(("BM_Order/" + q + "/after:" + p).c_str(), BM_Order, q, p);
+      b->Iterations(5)->UseRealTime()->Unit(benchmark::kMillisecond);
+    }
   }
   for (const bool lanes : {true, false}) {
     auto* b = benchmark::RegisterBenchmark(lanes ? "BM_MongeJetFit/lanes" : "BM_MongeJetFit/reference",

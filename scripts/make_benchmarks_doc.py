@@ -5,6 +5,15 @@
 
 Reads <results>/machine.txt and <results>/bench_{geometry,bending,bim}.json (Google Benchmark's
 --benchmark_format=json). Standard library only.
+
+With --section order, only the section "Order of the methods" of an existing --out is written
+again, from the BM_Order rows of <results>/bench_bending.json (and the load averages of
+<results>/machine.txt, if any), the rest of the document left as it is:
+
+    OMP_NUM_THREADS=1 ./build/release/bench_bending --benchmark_filter='BM_Order/' \\
+        --benchmark_repetitions=3 --benchmark_enable_random_interleaving=true \\
+        --benchmark_format=json > results/order/bench_bending.json
+    /usr/bin/python3 scripts/make_benchmarks_doc.py --section order --results results/order
 """
 import argparse
 import json
@@ -118,11 +127,115 @@ def verdict(ok):
     return "met" if ok else "**not met**"
 
 
+ORDER_HEADING = "## Order of the methods (`BM_Order`)"
+
+
+def order_section(bend, machine):
+    """Lines of the section on BM_Order: each method's time right after every other method."""
+    rows = [r for r in bend["rows"] if r["family"] == "BM_Order" and not r["error"]] if bend else []
+    if not rows:
+        return []
+    # In the order the pairs were registered (Q by Q, P by P: the registry's order of the methods),
+    # not the order they ran in, which random interleaving shuffles.
+    rows.sort(key=lambda r: r["b"].get("family_index", 0))
+    methods = []
+    for r in rows:
+        if r["variant"] not in methods:
+            methods.append(r["variant"])
+    before = []
+    for r in rows:
+        if r["args"].get("after") not in before:
+            before.append(r["args"].get("after"))
+    # Every repetition of a pair (a report with --benchmark_repetitions has several rows per name).
+    cell = {}
+    for r in rows:
+        cell.setdefault((r["variant"], r["args"].get("after")), []).append(r["b"])
+    repetitions = max(len(v) for v in cell.values())
+
+    def median(values):
+        v = sorted(values)
+        return 0.5 * (v[(len(v) - 1) // 2] + v[len(v) // 2])
+
+    def cv(values):
+        if len(values) < 2:
+            return None
+        m = sum(values) / len(values)
+        return (sum((x - m) ** 2 for x in values) / (len(values) - 1)) ** 0.5 / m
+    out = []
+    w = out.append
+    w(ORDER_HEADING)
+    w("")
+    w("Method Q's `compute_into` at 81920 triangles, one thread, right after an instance of method P")
+    w("ran three times and was destroyed, as when the benchmarks of P and Q follow each other: every")
+    w("method after every other (`BM_Order/<Q>/after:<P>`, 5 timed calls after 2 untimed ones). Before")
+    w("the methods kept their workspaces (`bending/method_workspace.hpp`), Method C's compute took")
+    w("46-70 ms of processor time after A and B against 7-14 ms alone in the same binary: each call")
+    w("allocated about 12 MB, which glibc trimmed from the top of its heap when the call freed it")
+    w("(whether it did depended on what A and B had left on the heap) and the next call faulted in")
+    w("again, about 3100 page faults per call at 14-17 us each. Now no method allocates once warm")
+    w("(`tests/allocation`), so no call faults in fresh pages: the table's last column, the most page")
+    w("faults per call over all predecessors, is the evidence that does not depend on the machine's")
+    w("load; the times vary only by the machine's noise.")
+    w("")
+    ls, le = machine.get("load_start"), machine.get("load_end")
+    if ls or le:
+        w(f"Load average (1, 5, 15 min) at the start: {ls or '-'}; at the end: {le or '-'} (2 cores).")
+        w("")
+    if repetitions > 1:
+        w(f"Processor time of the benchmark's thread per call (ms), the median of {repetitions} repetitions")
+        w("run in random order (`--benchmark_enable_random_interleaving`, so that a drift of the")
+        w("machine's load over the run does not look like an effect of the order), Q in rows, P in")
+        w("columns; spread = the largest over the smallest median of the row; noise = the largest")
+        w("coefficient of variation of one pair's repetitions in the row, the machine's own scatter.")
+    else:
+        w("Processor time of the benchmark's thread per call (ms), Q in rows, P in columns; spread = the")
+        w("largest over the smallest time of the row (one run of each pair: run with repetitions, as the")
+        w("top of `scripts/make_benchmarks_doc.py` shows, to see the machine's own scatter).")
+    w("")
+    w("| Q, after P: | " + " | ".join(before) + " | spread | noise | page faults per call (max) |")
+    w("| --- | " + " | ".join("---" for _ in before) + " | --- | --- | --- |")
+    for q in methods:
+        runs = [[cpu_seconds(b) * 1e3 for b in cell[(q, p)]] if (q, p) in cell else [] for p in before]
+        times = [median(t) if t else None for t in runs]
+        faults = [b.get("page_faults_per_call") for p in before for b in cell.get((q, p), [])]
+        known = [t for t in times if t is not None]
+        spread = f"{max(known) / min(known):.2f}" if known else "-"
+        cvs = [c for c in (cv(t) for t in runs) if c is not None]
+        noise = f"{max(cvs):.0%}" if cvs else "-"
+        fmax = max((f for f in faults if f is not None), default=None)
+        w(f"| {q} | " + " | ".join(f"{t:.4g}" if t is not None else "-" for t in times) +
+          f" | {spread} | {noise} | {'-' if fmax is None else f'{fmax:.3g}'} |")
+    w("")
+    return out
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--results", default="results/bench")
     ap.add_argument("--out", default="docs/benchmarks.md")
+    ap.add_argument("--section", choices=["order"],
+                    help="write only this section of an existing --out again (see the top of this script)")
     a = ap.parse_args()
+
+    if a.section == "order":
+        bend = load_report(os.path.join(a.results, "bench_bending.json"))
+        section = order_section(bend, read_machine(os.path.join(a.results, "machine.txt")))
+        if not section:
+            sys.exit(f"make_benchmarks_doc: no BM_Order rows in {a.results}/bench_bending.json")
+        with open(a.out) as f:
+            lines = f.read().split("\n")
+        if ORDER_HEADING in lines:
+            i = lines.index(ORDER_HEADING)
+            j = next((k for k in range(i + 1, len(lines)) if lines[k].startswith("## ")), len(lines))
+            lines[i:j] = section
+        else:  # before the closing section
+            j = lines.index("## Running one benchmark") if "## Running one benchmark" in lines else len(lines)
+            lines[j:j] = section
+        tmp = a.out + ".tmp"
+        with open(tmp, "w") as f:
+            f.write("\n".join(lines))
+        os.replace(tmp, a.out)
+        return
 
     machine = read_machine(os.path.join(a.results, "machine.txt"))
     geo = load_report(os.path.join(a.results, "bench_geometry.json"))
@@ -280,26 +393,33 @@ def main():
     if bend:
         w("## Bending forces (`bench_bending`)")
         w("")
-        w("MT1 meshes mapped onto the red blood cell of section 3; `compute` returns every per-vertex")
-        w("quantity, `forces` only the node forces (A and B implement it separately; for the other")
-        w("methods it calls `compute`). Methods D and ED are O(N): Belkin's heat kernel truncated where its")
+        w("MT1 meshes mapped onto the red blood cell of section 3; `compute` is timed as `compute_into`,")
+        w("every per-vertex quantity into a result kept from call to call, `forces` the node forces only;")
+        w("both after two untimed calls, which set up what a method keeps per mesh. Page faults per call:")
+        w("minor faults of the process per timed call (`getrusage`), pages touched for the first time,")
+        w("which no method causes once warm. Methods D and ED are O(N): Belkin's heat kernel truncated where its")
         w("weight falls below `kernel_cutoff` (1e-15), the neighbours found through a cell list once per")
         w("shape (`bending/belkin.hpp`); their O(N^2) all-pairs reference and D's cost per vertex and ratio")
         w("to C are measured by `bench/belkin_neighbours`. A method of registry cost O(N^2) would run a")
         w("single iteration at 81920 triangles. `E_rings2`, `E_rings3`: Method E fitted on 2 and 3 rings.")
         w("")
-        w("| method | call | triangles | threads | time (ms) | CPU time of the main thread (ms) | vertices/s | vertices/s per thread | iterations |")
-        w("| --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+        w("| method | call | triangles | threads | time (ms) | CPU time of the main thread (ms) | vertices/s | vertices/s per thread | iterations | page faults per call |")
+        w("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
         for r in bend["rows"]:
+            if r["family"] == "BM_Order":
+                continue  # its own section below
             b = r["b"]
             call = "forces" if r["family"] == "BM_Forces" else "compute"
             a_ = r["args"]
             if r["error"]:
-                w(f"| {r['variant']} | {call} | {a_.get('triangles')} | {a_.get('threads')} | error: {r['error']} | - | - | - | - |")
+                w(f"| {r['variant']} | {call} | {a_.get('triangles')} | {a_.get('threads')} | error: {r['error']} | - | - | - | - | - |")
                 continue
+            faults = b.get("page_faults_per_call")
             w(f"| {r['variant']} | {call} | {a_.get('triangles')} | {a_.get('threads')} | {ms(seconds(b))} | {ms(cpu_seconds(b))} | "
-              f"{si(b.get('vertices_per_s'))} | {si(b.get('vertices_per_s_per_thread'))} | {b.get('iterations')} |")
+              f"{si(b.get('vertices_per_s'))} | {si(b.get('vertices_per_s_per_thread'))} | {b.get('iterations')} | "
+              f"{'-' if faults is None else f'{faults:.3g}'} |")
         w("")
+        out.extend(order_section(bend, machine))
 
     # ---------------------------------------------------------------- BIM
     if bim:

@@ -67,6 +67,13 @@ BendingResult BendingMethod::compute(const Topology& topology, const Points& x, 
   return compute_terms(topology, x, p);
 }
 
+void BendingMethod::compute_into(const Topology& topology, const Points& x, const BendingParameters& p,
+                                 BendingResult& out) const {
+  if (p.plain()) return compute_into(topology, x, p.kappa_b, out);
+  check_parameters(p);
+  compute_terms_into(topology, x, p, out);
+}
+
 void BendingMethod::forces(const Topology& topology, const Points& x, const BendingParameters& p,
                            Points& force) const {
   if (p.plain()) return forces(topology, x, p.kappa_b, force);

@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <omp.h>
+
 #include <cmath>
 #include <limits>
 
@@ -178,12 +180,43 @@ double farutin_laplacian_point(const FarutinFit& fit, const Vec3& x0, std::span<
   return fit.lap_weights.dot(rhs);
 }
 
+// One thread's buffers: its neighbourhood (for one topology) and the values of a field on it.
+struct FarutinWorkspace::Thread {
+  explicit Thread(const Topology& t) : topology(&t), nb(t) {}
+  const Topology* topology;
+  Neighbourhood nb;
+  std::vector<double> values;
+};
+
+FarutinWorkspace::FarutinWorkspace() = default;
+FarutinWorkspace::~FarutinWorkspace() = default;
+
+void FarutinWorkspace::prepare() {
+  const auto n = static_cast<std::size_t>(omp_get_max_threads());
+  if (threads_.size() < n) threads_.resize(n);
+}
+
+FarutinWorkspace::Thread& FarutinWorkspace::thread(int k, const Topology& topology) {
+  std::unique_ptr<Thread>& slot = threads_[k];
+  if (!slot || slot->topology != &topology) slot = std::make_unique<Thread>(topology);
+  return *slot;
+}
+
 std::vector<FarutinFit> farutin_fit(const Topology& t, const Points& x, const Points& normal_guess, int rings) {
+  FarutinWorkspace ws;
+  std::vector<FarutinFit> fits;
+  farutin_fit(t, x, normal_guess, rings, ws, fits);
+  return fits;
+}
+
+void farutin_fit(const Topology& t, const Points& x, const Points& normal_guess, int rings, FarutinWorkspace& ws,
+                 std::vector<FarutinFit>& fits) {
   const int n = t.num_vertices();
-  std::vector<FarutinFit> fits(n);
+  fits.resize(n);
+  ws.prepare();
 #pragma omp parallel
   {
-    Neighbourhood nb(t);
+    Neighbourhood& nb = ws.thread(omp_get_thread_num(), t).nb;
 #pragma omp for schedule(static)
     for (int i = 0; i < n; ++i) {
       nb.start(i);
@@ -198,7 +231,6 @@ std::vector<FarutinFit> farutin_fit(const Topology& t, const Points& x, const Po
       fits[i] = fit;
     }
   }
-  return fits;
 }
 
 void require_valid_fits(const std::vector<FarutinFit>& fits, std::string_view method) {
@@ -211,12 +243,22 @@ void require_valid_fits(const std::vector<FarutinFit>& fits, std::string_view me
 }
 
 Scalars farutin_laplacian(const Topology& t, const Points& x, const std::vector<FarutinFit>& fits, const Scalars& w) {
+  FarutinWorkspace ws;
+  Scalars out;
+  farutin_laplacian(t, x, fits, w, ws, out);
+  return out;
+}
+
+void farutin_laplacian(const Topology& t, const Points& x, const std::vector<FarutinFit>& fits, const Scalars& w,
+                       FarutinWorkspace& ws, Scalars& out) {
   const int n = t.num_vertices();
-  Scalars out(n);
+  out.resize(n);
+  ws.prepare();
 #pragma omp parallel
   {
-    Neighbourhood nb(t);
-    std::vector<double> values;
+    FarutinWorkspace::Thread& scratch = ws.thread(omp_get_thread_num(), t);
+    Neighbourhood& nb = scratch.nb;
+    std::vector<double>& values = scratch.values;
 #pragma omp for schedule(static)
     for (int i = 0; i < n; ++i) {
       const FarutinFit& fit = fits[i];
@@ -232,18 +274,24 @@ Scalars farutin_laplacian(const Topology& t, const Points& x, const std::vector<
       out[i] = farutin_laplacian_point(fit, x.row(i).transpose(), nb.gather(x), w[i], values);
     }
   }
-  return out;
 }
 
 FarutinFields farutin_fields(const std::vector<FarutinFit>& fits) {
-  const auto n = static_cast<Eigen::Index>(fits.size());
-  FarutinFields out{Points(n, 3), Scalars(n), Scalars(n)};
-  for (Eigen::Index i = 0; i < n; ++i) {
-    out.normal.row(i) = fits[i].normal.transpose();
-    out.H[i] = fits[i].H;
-    out.K[i] = fits[i].K;
-  }
+  FarutinFields out;
+  farutin_fields(fits, out.normal, out.H, out.K);
   return out;
+}
+
+void farutin_fields(const std::vector<FarutinFit>& fits, Points& normal, Scalars& H, Scalars& K) {
+  const auto n = static_cast<Eigen::Index>(fits.size());
+  normal.resize(n, 3);
+  H.resize(n);
+  K.resize(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    normal.row(i) = fits[i].normal.transpose();
+    H[i] = fits[i].H;
+    K[i] = fits[i].K;
+  }
 }
 
 OptionSpec farutin_rings_option() {
@@ -256,9 +304,18 @@ int parse_farutin_rings(const MethodOptions& options, const std::string& method)
   return static_cast<int>(option_int(resolve_method_options(schema, options), "rings"));
 }
 
+// Kept by the method instance and reused from call to call (method_workspace.hpp).
+struct FarutinMethod::Workspace {
+  MeshGeometry geometry;
+  std::vector<FarutinFit> fits;
+  FarutinWorkspace buffers;
+};
+
 FarutinMethod::FarutinMethod(int rings) : rings_(rings) {
   if (rings < 1) throw Error("method E: rings must be at least 1, got " + std::to_string(rings));
 }
+
+FarutinMethod::~FarutinMethod() = default;
 
 std::unique_ptr<BendingMethod> FarutinMethod::create(const MethodOptions& options) {
   return std::make_unique<FarutinMethod>(parse_farutin_rings(options, "E"));
@@ -270,20 +327,15 @@ MethodInfo FarutinMethod::info() {
   return m;
 }
 
-BendingResult FarutinMethod::compute(const Topology& topology, const Points& x, double kappa_b) const {
-  return compute_terms(topology, x, BendingParameters(kappa_b));  // plain: eq. (10) unchanged
-}
-
-// With c0 and ADE the force law of docs/conventions.md §5 from the same H, K, Lap H and n.
-BendingResult FarutinMethod::compute_terms(const Topology& topology, const Points& x,
-                                           const BendingParameters& params) const {
-  const MeshGeometry geometry = MeshGeometry::compute(topology, x);
-  const std::vector<FarutinFit> fits = farutin_fit(topology, x, geometry.normal_mwa, rings_);
-  require_valid_fits(fits, "E");
-  FarutinFields e = farutin_fields(fits);
-  Scalars lapH = farutin_laplacian(topology, x, fits, e.H);
-  return assemble_variational_result(std::move(e.normal), std::move(e.H), std::move(e.K), std::move(lapH),
-                                     geometry.mixed_area, params);
+void FarutinMethod::fields(const Topology& topology, const Points& x, BendingResult& out) const {
+  const auto ws = workspace_.acquire();
+  MeshGeometry& geometry = ws->geometry;
+  MeshGeometry::compute(topology, x, geometry);
+  farutin_fit(topology, x, geometry.normal_mwa, rings_, ws->buffers, ws->fits);
+  require_valid_fits(ws->fits, "E");
+  farutin_fields(ws->fits, out.normal, out.H, out.K);
+  farutin_laplacian(topology, x, ws->fits, out.H, ws->buffers, out.lapH);
+  out.area.swap(geometry.mixed_area);  // no copy; next call the arrays are reused
 }
 
 }  // namespace bendlab

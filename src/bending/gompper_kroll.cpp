@@ -22,9 +22,8 @@ struct VertexSums {
   Scalars m;  ///< with c0 / ADE only: m_i = H_i A_i = sign(S_i . N_i) |S_i| / 4
 };
 
-// Scratch arrays of the kernel, kept per calling thread and reused from call to call, so a time
-// loop does not allocate (and page in) fresh memory at every step.
-struct Workspace {
+// Scratch arrays of the kernel.
+struct KernelScratch {
   std::vector<double> half_T, us, corner_grad, m;
 };
 
@@ -64,7 +63,8 @@ struct Workspace {
 // so only u_i and s_i of the derivation above change:
 //   u_i = 4 S_i / D_i + (lambda / (2 kB) - 2 c0) sigma_i S_i / |S_i|,   s_i = 2 |S_i|^2 / D_i^2 - c0^2 / 2,
 // lambda / kB = alpha pi (M - M0) / A. Plain parameters keep the expressions above.
-double gk_kernel(const Topology& t, const Points& x, const BendingParameters& p, Points* force, VertexSums* sums) {
+double gk_kernel(const Topology& t, const Points& x, const BendingParameters& p, Points* force, VertexSums* sums,
+                 KernelScratch& ws) {
   const double kappa_b = p.kappa_b;
   const bool plain = p.plain();
   const int nf = t.num_faces(), nv = t.num_vertices(), ne = t.num_edges();
@@ -77,7 +77,6 @@ double gk_kernel(const Topology& t, const Points& x, const BendingParameters& p,
   const auto& rfaces = t.ring_faces();
   const auto& rcorners = t.ring_corners();
 
-  static thread_local Workspace ws;
   // half_T[2e + s] = cotangent of the corner opposite e in edge_faces(e, s); T_e is their sum.
   ws.half_T.resize(2 * static_cast<size_t>(ne));
   // Per vertex: u_i (3) and s_i of the derivation above.
@@ -229,6 +228,18 @@ double gk_kernel(const Topology& t, const Points& x, const BendingParameters& p,
 
 }  // namespace
 
+// The kernel's scratch, its sums and compute()'s geometry, kept by the method instance and reused
+// from call to call, so a time loop does not allocate (and page in) fresh memory at every step
+// (method_workspace.hpp).
+struct GompperKroll::Workspace {
+  KernelScratch kernel;
+  VertexSums sums;
+  MeshGeometry geometry;
+};
+
+GompperKroll::GompperKroll() = default;
+GompperKroll::~GompperKroll() = default;
+
 std::unique_ptr<BendingMethod> GompperKroll::create(const MethodOptions& options) {
   resolve_method_options(info(), options);  // B takes no options: refuses any
   return std::make_unique<GompperKroll>();
@@ -243,31 +254,43 @@ MethodInfo GompperKroll::info() {
 }
 
 void GompperKroll::forces(const Topology& t, const Points& x, double kappa_b, Points& force) const {
-  gk_kernel(t, x, BendingParameters(kappa_b), &force, nullptr);
+  gk_kernel(t, x, BendingParameters(kappa_b), &force, nullptr, workspace_.acquire()->kernel);
 }
 
 std::optional<double> GompperKroll::energy(const Topology& t, const Points& x, double kappa_b) const {
-  return gk_kernel(t, x, BendingParameters(kappa_b), nullptr, nullptr);
+  return gk_kernel(t, x, BendingParameters(kappa_b), nullptr, nullptr, workspace_.acquire()->kernel);
 }
 
 BendingResult GompperKroll::compute(const Topology& t, const Points& x, double kappa_b) const {
   return compute_terms(t, x, BendingParameters(kappa_b));
 }
 
+void GompperKroll::compute_into(const Topology& t, const Points& x, double kappa_b, BendingResult& out) const {
+  compute_terms_into(t, x, BendingParameters(kappa_b), out);
+}
+
 void GompperKroll::forces_terms(const Topology& t, const Points& x, const BendingParameters& p, Points& force) const {
-  gk_kernel(t, x, p, &force, nullptr);
+  gk_kernel(t, x, p, &force, nullptr, workspace_.acquire()->kernel);
 }
 
 std::optional<double> GompperKroll::energy_terms(const Topology& t, const Points& x, const BendingParameters& p) const {
-  return gk_kernel(t, x, p, nullptr, nullptr);
+  return gk_kernel(t, x, p, nullptr, nullptr, workspace_.acquire()->kernel);
 }
 
 BendingResult GompperKroll::compute_terms(const Topology& t, const Points& x, const BendingParameters& p) const {
-  const int nv = t.num_vertices();
   BendingResult r;
-  VertexSums sums;
-  r.energy = gk_kernel(t, x, p, &r.force, &sums);
-  MeshGeometry g = MeshGeometry::compute(t, x);
+  compute_terms_into(t, x, p, r);
+  return r;
+}
+
+void GompperKroll::compute_terms_into(const Topology& t, const Points& x, const BendingParameters& p,
+                                      BendingResult& r) const {
+  const int nv = t.num_vertices();
+  const auto ws = workspace_.acquire();
+  VertexSums& sums = ws->sums;
+  r.energy = gk_kernel(t, x, p, &r.force, &sums, ws->kernel);
+  MeshGeometry& g = ws->geometry;
+  MeshGeometry::compute(t, x, g);
   r.H.resize(nv);
   r.force_density.resize(nv, 3);
   for (int i = 0; i < nv; ++i) {
@@ -280,11 +303,11 @@ BendingResult GompperKroll::compute_terms(const Topology& t, const Points& x, co
       r.H[i] = sums.m[i] < 0 ? -magnitude : magnitude;
     r.force_density.row(i) = r.force.row(i) / g.mixed_area[i];  // eq. (14)
   }
-  r.area = std::move(g.mixed_area);
-  r.normal = std::move(g.normal_mwa);
-  r.K = std::move(g.gaussian_curvature);
-  r.lapH = Scalars::Constant(nv, std::numeric_limits<double>::quiet_NaN());
-  return r;
+  // The geometry's arrays change places with the result's (no copy; next call they are reused).
+  r.area.swap(g.mixed_area);
+  r.normal.swap(g.normal_mwa);
+  r.K.swap(g.gaussian_curvature);
+  r.lapH.setConstant(nv, std::numeric_limits<double>::quiet_NaN());
 }
 
 }  // namespace bendlab

@@ -20,6 +20,17 @@ struct Sums {
   Scalars M, A;
 };
 
+// The kernel's arrays (reused from call to call).
+struct KernelScratch {
+  Points normal;  // unit face normals
+  Scalars area;   // face areas
+  Scalars len, theta;
+  Sums sums;
+  Scalars alpha, beta;
+  Points ga, gb, go0, go1;
+  Scalars gface;
+};
+
 // The derivation. With M_i = sum_{e at i} l_e theta_e and A_i as in the header,
 //   E = kB/8 sum_i M_i^2 / A_i,   dE = sum_i alpha_i dM_i - beta_i dA_i,
 //   alpha_i = kB M_i / (4 A_i) = kB H_i,   beta_i = kB M_i^2 / (8 A_i^2) = 2 kB H_i^2.
@@ -42,7 +53,8 @@ struct Sums {
 //   alpha_i = kB (H_i - c0) + lambda / 4,   beta_i = 2 kB (H_i^2 - c0^2),
 // lambda = alpha pi kB (M - M0) / A (BendingParameters::ade_lambda). Plain parameters keep the
 // expressions above, operation for operation.
-double kernel(const Topology& t, const Points& x, const BendingParameters& p, Points* force, Sums* sums_out) {
+// Returns the energy; fills *force when given; the per-vertex sums are left in ws.sums.
+double kernel(const Topology& t, const Points& x, const BendingParameters& p, Points* force, KernelScratch& ws) {
   const double kappa_b = p.kappa_b;
   const bool plain = p.plain();
   const int nf = t.num_faces(), nv = t.num_vertices(), ne = t.num_edges();
@@ -56,10 +68,15 @@ double kernel(const Topology& t, const Points& x, const BendingParameters& p, Po
   const auto& rcorners = t.ring_corners();
   const Faces& FE = t.face_edges();
 
-  Points normal(nf, 3);     // unit face normals
-  Scalars area(nf);         // face areas
-  Scalars len(ne), theta(ne);
-  Sums s;
+  Points& normal = ws.normal;  // unit face normals
+  Scalars& area = ws.area;     // face areas
+  Scalars& len = ws.len;
+  Scalars& theta = ws.theta;
+  normal.resize(nf, 3);
+  area.resize(nf);
+  len.resize(ne);
+  theta.resize(ne);
+  Sums& s = ws.sums;
   s.M.resize(nv);
   s.A.resize(nv);
   double energy = 0;
@@ -96,7 +113,8 @@ double kernel(const Topology& t, const Points& x, const BendingParameters& p, Po
     }
   }
   // The weights alpha_i, beta_i with c0 and ADE (unused when plain).
-  Scalars alpha, beta;
+  Scalars& alpha = ws.alpha;
+  Scalars& beta = ws.beta;
   if (!plain) {
     energy = 0;
     double mtot = 0;
@@ -116,8 +134,16 @@ double kernel(const Topology& t, const Points& x, const BendingParameters& p, Po
   if (force != nullptr) {
     force->resize(nv, 3);
     // Per edge: the weighted gradient of l_e theta_e w.r.t. a, b, o0, o1 (dE terms of the edge).
-    Points ga(ne, 3), gb(ne, 3), go0(ne, 3), go1(ne, 3);
-    Scalars gface(nf);
+    Points& ga = ws.ga;
+    Points& gb = ws.gb;
+    Points& go0 = ws.go0;
+    Points& go1 = ws.go1;
+    Scalars& gface = ws.gface;
+    ga.resize(ne, 3);
+    gb.resize(ne, 3);
+    go0.resize(ne, 3);
+    go1.resize(ne, 3);
+    gface.resize(nf);
 #pragma omp parallel if (par)
     {
 #pragma omp for schedule(static)
@@ -177,11 +203,21 @@ double kernel(const Topology& t, const Points& x, const BendingParameters& p, Po
       }
     }
   }
-  if (sums_out != nullptr) *sums_out = std::move(s);
   return energy;
 }
 
 }  // namespace
+
+// The kernel's arrays and compute()'s geometry, kept by the method instance and reused from call
+// to call, so a time loop does not allocate (and page in) fresh memory at every step
+// (method_workspace.hpp).
+struct JulicherMethod::Workspace {
+  KernelScratch kernel;
+  MeshGeometry geometry;
+};
+
+JulicherMethod::JulicherMethod() = default;
+JulicherMethod::~JulicherMethod() = default;
 
 std::unique_ptr<BendingMethod> JulicherMethod::create(const MethodOptions& options) {
   resolve_method_options(info(), options);  // J takes no options: refuses any
@@ -197,33 +233,45 @@ MethodInfo JulicherMethod::info() {
 }
 
 void JulicherMethod::forces(const Topology& t, const Points& x, double kappa_b, Points& force) const {
-  kernel(t, x, BendingParameters(kappa_b), &force, nullptr);
+  kernel(t, x, BendingParameters(kappa_b), &force, workspace_.acquire()->kernel);
 }
 
 std::optional<double> JulicherMethod::energy(const Topology& t, const Points& x, double kappa_b) const {
-  return kernel(t, x, BendingParameters(kappa_b), nullptr, nullptr);
+  return kernel(t, x, BendingParameters(kappa_b), nullptr, workspace_.acquire()->kernel);
 }
 
 BendingResult JulicherMethod::compute(const Topology& t, const Points& x, double kappa_b) const {
   return compute_terms(t, x, BendingParameters(kappa_b));
 }
 
+void JulicherMethod::compute_into(const Topology& t, const Points& x, double kappa_b, BendingResult& out) const {
+  compute_terms_into(t, x, BendingParameters(kappa_b), out);
+}
+
 void JulicherMethod::forces_terms(const Topology& t, const Points& x, const BendingParameters& p,
                                   Points& force) const {
-  kernel(t, x, p, &force, nullptr);
+  kernel(t, x, p, &force, workspace_.acquire()->kernel);
 }
 
 std::optional<double> JulicherMethod::energy_terms(const Topology& t, const Points& x,
                                                    const BendingParameters& p) const {
-  return kernel(t, x, p, nullptr, nullptr);
+  return kernel(t, x, p, nullptr, workspace_.acquire()->kernel);
 }
 
 BendingResult JulicherMethod::compute_terms(const Topology& t, const Points& x, const BendingParameters& p) const {
-  const int nv = t.num_vertices();
   BendingResult r;
-  Sums s;
-  r.energy = kernel(t, x, p, &r.force, &s);
-  MeshGeometry g = MeshGeometry::compute(t, x);
+  compute_terms_into(t, x, p, r);
+  return r;
+}
+
+void JulicherMethod::compute_terms_into(const Topology& t, const Points& x, const BendingParameters& p,
+                                        BendingResult& r) const {
+  const int nv = t.num_vertices();
+  const auto ws = workspace_.acquire();
+  r.energy = kernel(t, x, p, &r.force, ws->kernel);
+  const Sums& s = ws->kernel.sums;
+  MeshGeometry& g = ws->geometry;
+  MeshGeometry::compute(t, x, g);
   r.H.resize(nv);
   r.K.resize(nv);
   r.normal.resize(nv, 3);
@@ -239,9 +287,8 @@ BendingResult JulicherMethod::compute_terms(const Topology& t, const Points& x, 
     r.normal.row(i) = n.normalized().transpose();
     r.force_density.row(i) = r.force.row(i) / g.mixed_area[i];  // eq. (14)
   }
-  r.area = std::move(g.mixed_area);
-  r.lapH = Scalars::Constant(nv, std::numeric_limits<double>::quiet_NaN());
-  return r;
+  r.area.swap(g.mixed_area);  // no copy; next call the arrays are reused
+  r.lapH.setConstant(nv, std::numeric_limits<double>::quiet_NaN());
 }
 
 }  // namespace bendlab

@@ -22,13 +22,18 @@ inline Vec3 xrow(const Points& x, int i) { return Vec3(x(i, 0), x(i, 1), x(i, 2)
 // Below this many faces a call takes a few microseconds and starting threads costs more than it saves.
 constexpr int kParallelMinFaces = 4096;
 
-// Scratch arrays of the force kernel, kept per calling thread and reused from call to call, so a
-// time loop does not allocate (and page in) fresh memory at every step.
-struct Workspace {
+}  // namespace
+
+// Scratch arrays of the force kernel and the geometry of compute(), kept by the method instance
+// and reused from call to call, so a time loop does not allocate (and page in) fresh memory at
+// every step (method_workspace.hpp).
+struct KantorNelson::Workspace {
   std::vector<double> normal, inv_len, dEdc, W;
+  MeshGeometry geometry;
 };
 
-}  // namespace
+KantorNelson::KantorNelson(bool small_angle) : small_angle_(small_angle) {}
+KantorNelson::~KantorNelson() = default;
 
 std::unique_ptr<BendingMethod> KantorNelson::create(const MethodOptions& options) {
   const MethodOptions o = resolve_method_options(info(), options);
@@ -69,7 +74,8 @@ MethodInfo KantorNelson::info() {
 //
 // Each loop writes only to its own element (faces, edges, vertices) and gathers from its
 // neighbours, so the loops run in parallel without write conflicts.
-double KantorNelson::energy_and_forces(const Topology& t, const Points& x, double kappa_b, Points& force) const {
+double KantorNelson::energy_and_forces(const Topology& t, const Points& x, double kappa_b, Points& force,
+                                       Workspace& ws) const {
   const int nf = t.num_faces(), nv = t.num_vertices(), ne = t.num_edges();
   const Faces& F = t.faces();
   const Faces& FE = t.face_edges();
@@ -80,7 +86,6 @@ double KantorNelson::energy_and_forces(const Topology& t, const Points& x, doubl
   const double kt = std::sqrt(3.0) * kappa_b;  // kB~ of eq. (6)
   const bool small = small_angle_;
 
-  static thread_local Workspace ws;
   ws.normal.resize(3 * static_cast<size_t>(nf));  // unit face normals n_f
   ws.inv_len.resize(nf);                          // 1 / |m_f|
   ws.dEdc.resize(ne);                             // dE_e / dc per edge
@@ -143,7 +148,7 @@ double KantorNelson::energy_and_forces(const Topology& t, const Points& x, doubl
 }
 
 void KantorNelson::forces(const Topology& t, const Points& x, double kappa_b, Points& force) const {
-  energy_and_forces(t, x, kappa_b, force);
+  energy_and_forces(t, x, kappa_b, force, *workspace_.acquire());
 }
 
 std::optional<double> KantorNelson::energy(const Topology& t, const Points& x, double kappa_b) const {
@@ -170,19 +175,26 @@ std::optional<double> KantorNelson::energy(const Topology& t, const Points& x, d
 }
 
 BendingResult KantorNelson::compute(const Topology& t, const Points& x, double kappa_b) const {
+  BendingResult r;
+  compute_into(t, x, kappa_b, r);
+  return r;
+}
+
+void KantorNelson::compute_into(const Topology& t, const Points& x, double kappa_b, BendingResult& r) const {
   const int nv = t.num_vertices();
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  BendingResult r;
-  r.energy = energy_and_forces(t, x, kappa_b, r.force);
-  MeshGeometry g = MeshGeometry::compute(t, x);
-  r.area = std::move(g.mixed_area);
-  r.normal = std::move(g.normal_mwa);
+  const auto ws = workspace_.acquire();
+  r.energy = energy_and_forces(t, x, kappa_b, r.force, *ws);
+  MeshGeometry& g = ws->geometry;
+  MeshGeometry::compute(t, x, g);
+  // The geometry's arrays change places with the result's (no copy; next call they are reused).
+  r.area.swap(g.mixed_area);
+  r.normal.swap(g.normal_mwa);
   r.force_density.resize(nv, 3);
   for (int i = 0; i < nv; ++i) r.force_density.row(i) = r.force.row(i) / r.area[i];  // eq. (14)
-  r.H = Scalars::Constant(nv, nan);
-  r.K = Scalars::Constant(nv, nan);
-  r.lapH = Scalars::Constant(nv, nan);
-  return r;
+  r.H.setConstant(nv, nan);
+  r.K.setConstant(nv, nan);
+  r.lapH.setConstant(nv, nan);
 }
 
 }  // namespace bendlab

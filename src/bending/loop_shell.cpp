@@ -38,7 +38,8 @@ struct LoopShellMethod::Cache {
         bases(loop_shell::dunavant_rule(gauss_points), distinct(patches.valence)),
         limit(loop_shell::limit_matrix(t)),
         mass(patches, t.num_vertices()),
-        colouring(loop_shell::FaceColouring::build(patches, t.num_vertices())) {
+        colouring(loop_shell::FaceColouring::build(patches, t.num_vertices())),
+        curvature_bases(loop_shell::LimitCurvatureBases::build(t, patches)) {
     if (solve_control) limit_solver.emplace(t);
     if (factorize_mass) mass_ldlt.analyzePattern(mass.pattern());
   }
@@ -51,6 +52,7 @@ struct LoopShellMethod::Cache {
   SparseMatrix limit;
   loop_shell::MassPattern mass;
   loop_shell::FaceColouring colouring;
+  loop_shell::LimitCurvatureBases curvature_bases;
   std::mutex mutex;
   // The last solution of M f_c = F_c (under `mutex`): the next CG solve on this topology starts
   // from it. Successive shapes of a flow run differ little, so this saves most iterations; the
@@ -66,6 +68,21 @@ namespace {
 constexpr size_t kMaxCachedTopologies = 8;
 
 }  // namespace
+
+// What one evaluation writes, kept by the method instance and reused from call to call
+// (method_workspace.hpp); m and its pattern belong to `cache`.
+struct LoopShellMethod::Workspace {
+  std::shared_ptr<Cache> cache;
+  SparseMatrix m;
+  Points control, gradient;
+  Eigen::MatrixXd limit_rhs, limit_work;
+  Eigen::VectorXd h_rhs;
+  Eigen::MatrixXd rhs, start, solution, fc, product;
+  Eigen::VectorXd h_product;
+  loop_shell::CgBuffers cg;
+  CornerValues corner_mixed;
+  BendingResult result;  // forces()
+};
 
 std::unique_ptr<BendingMethod> LoopShellMethod::create(const MethodOptions& options) {
   const MethodOptions o = resolve_method_options(info(), options);
@@ -163,40 +180,78 @@ LoopShellState LoopShellMethod::state(const Topology& topology, const Points& x,
   return s;
 }
 
-BendingResult LoopShellMethod::evaluate(const Topology& topology, const Points& x, const BendingParameters& p,
-                                        bool nodal_geometry) const {
-  auto cache = cache_for(topology);
+void LoopShellMethod::evaluate(const Topology& topology, const Points& x, const BendingParameters& p,
+                               bool nodal_geometry, BendingResult& r, Workspace& ws) const {
+  if (x.rows() != topology.num_vertices())
+    throw Error("method S: " + std::to_string(x.rows()) + " positions for " +
+                std::to_string(topology.num_vertices()) + " vertices");
+  std::shared_ptr<Cache> cache = cache_for(topology);
+  if (ws.cache != cache) {  // another topology: the mass matrix's pattern (its values are assembled below)
+    ws.m = cache->mass.pattern();
+    ws.cache = cache;
+  }
   const int nv = topology.num_vertices();
-  BendingResult r;
-  const Points control = control_points(topology, x);
-  Points gradient;
+  // Step 1 (control_points).
+  const Points& control = ws.control;
+  if (control_ == Control::Nodes)
+    ws.control = x;
+  else
+    cache->limit_solver->solve(x, ws.control, ws.limit_rhs, ws.limit_work);
   const bool project_h = nodal_geometry && h_mode_ == HMode::Projection;
-  SparseMatrix m = cache->mass.pattern();
-  Eigen::VectorXd h_rhs;
   double ade = 0;
   const loop_shell::ShellTerms terms = shell_terms(*cache, control, p, &ade);
   r.energy = loop_shell::shell_energy_mass(cache->patches, cache->bases, cache->mass, cache->colouring, control,
-                                           terms, gradient, m, project_h ? &h_rhs : nullptr);
+                                           terms, ws.gradient, ws.m, project_h ? &ws.h_rhs : nullptr);
   if (!p.plain()) *r.energy += ade;
-  Eigen::MatrixXd rhs(nv, project_h ? 4 : 3);
-  rhs.leftCols(3) = -gradient;
-  if (project_h) rhs.col(3) = h_rhs;
-  const Eigen::MatrixXd solution = solve_mass(*cache, m, rhs);
-  const Eigen::MatrixXd fc = solution.leftCols(3);
-  r.force_density = cache->limit * fc;
-  r.area = mixed_area(topology, x);
+  Eigen::MatrixXd& rhs = ws.rhs;
+  rhs.resize(nv, project_h ? 4 : 3);
+  rhs.leftCols(3) = -ws.gradient;
+  if (project_h) rhs.col(3) = ws.h_rhs;
+  solve_mass(*cache, ws.m, rhs, ws);
+  const Eigen::MatrixXd& solution = ws.solution;
+  ws.fc = solution.leftCols(3);
+  ws.product.noalias() = cache->limit * ws.fc;
+  r.force_density = ws.product;
+  mixed_area(topology, x, r.area, ws.corner_mixed);
   r.force = r.force_density.array().colwise() * r.area.array();
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  r.lapH = Scalars::Constant(nv, nan);
+  r.lapH.setConstant(nv, nan);
   if (nodal_geometry) {
-    r.normal = loop_shell::limit_normals(topology, control);
-    loop_shell::limit_curvatures(topology, cache->patches, control, r.H, r.K);
-    if (project_h) r.H = cache->limit * solution.col(3);
+    loop_shell::limit_normals(topology, control, r.normal);
+    loop_shell::limit_curvatures(topology, cache->patches, cache->curvature_bases, control, r.H, r.K);
+    if (project_h) {
+      ws.h_product.noalias() = cache->limit * solution.col(3);
+      r.H = ws.h_product;
+    }
   } else {
-    r.normal = Points::Constant(nv, 3, nan);
-    r.H = r.K = Scalars::Constant(nv, nan);
+    r.normal.setConstant(nv, 3, nan);
+    r.H.setConstant(nv, nan);
+    r.K.setConstant(nv, nan);
   }
-  return r;
+}
+
+void LoopShellMethod::solve_mass(Cache& cache, const SparseMatrix& m, const Eigen::MatrixXd& b, Workspace& ws) const {
+  if (solver_ == Solver::CG) {
+    // The previous solution on this topology, when there is one of this size (else a cold start,
+    // as solve_mass_cg does for it); `start` keeps its storage either way.
+    ws.start.resize(b.rows(), b.cols());
+    bool warm = false;
+    {
+      std::lock_guard<std::mutex> lock(cache.mutex);
+      warm = cache.last_solution.rows() == b.rows() && cache.last_solution.cols() == b.cols();
+      if (warm) ws.start = cache.last_solution;
+    }
+    loop_shell::solve_mass_cg(m, b, kCgTolerance, 10000, nullptr, warm ? &ws.start : nullptr, 2000, ws.cg,
+                              ws.solution);
+    std::lock_guard<std::mutex> lock(cache.mutex);
+    cache.last_solution = ws.solution;
+    return;
+  }
+  // (Eigen's factorisation and solve allocate their own temporaries.)
+  std::lock_guard<std::mutex> lock(cache.mutex);
+  cache.mass_ldlt.factorize(m);
+  if (cache.mass_ldlt.info() != Eigen::Success) throw Error("method S: the mass matrix is not positive definite");
+  ws.solution = cache.mass_ldlt.solve(b);
 }
 
 Eigen::MatrixXd LoopShellMethod::solve_mass(Cache& cache, const SparseMatrix& m, const Eigen::MatrixXd& b) const {
@@ -218,11 +273,20 @@ Eigen::MatrixXd LoopShellMethod::solve_mass(Cache& cache, const SparseMatrix& m,
 }
 
 BendingResult LoopShellMethod::compute(const Topology& topology, const Points& x, double kappa_b) const {
-  return evaluate(topology, x, kappa_b, true);
+  BendingResult r;
+  evaluate(topology, x, kappa_b, true, r, *workspace_.acquire());
+  return r;
+}
+
+void LoopShellMethod::compute_into(const Topology& topology, const Points& x, double kappa_b,
+                                   BendingResult& out) const {
+  evaluate(topology, x, kappa_b, true, out, *workspace_.acquire());
 }
 
 void LoopShellMethod::forces(const Topology& topology, const Points& x, double kappa_b, Points& force) const {
-  force = evaluate(topology, x, kappa_b, false).force;
+  const auto ws = workspace_.acquire();
+  evaluate(topology, x, kappa_b, false, ws->result, *ws);
+  force = ws->result.force;
 }
 
 std::optional<double> LoopShellMethod::energy(const Topology& topology, const Points& x, double kappa_b) const {
@@ -231,12 +295,21 @@ std::optional<double> LoopShellMethod::energy(const Topology& topology, const Po
 
 BendingResult LoopShellMethod::compute_terms(const Topology& topology, const Points& x,
                                              const BendingParameters& p) const {
-  return evaluate(topology, x, p, true);
+  BendingResult r;
+  evaluate(topology, x, p, true, r, *workspace_.acquire());
+  return r;
+}
+
+void LoopShellMethod::compute_terms_into(const Topology& topology, const Points& x, const BendingParameters& p,
+                                         BendingResult& out) const {
+  evaluate(topology, x, p, true, out, *workspace_.acquire());
 }
 
 void LoopShellMethod::forces_terms(const Topology& topology, const Points& x, const BendingParameters& p,
                                    Points& force) const {
-  force = evaluate(topology, x, p, false).force;
+  const auto ws = workspace_.acquire();
+  evaluate(topology, x, p, false, ws->result, *ws);
+  force = ws->result.force;
 }
 
 std::optional<double> LoopShellMethod::energy_terms(const Topology& topology, const Points& x,

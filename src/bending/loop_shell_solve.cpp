@@ -55,21 +55,40 @@ void symmetric_product(const Eigen::SparseMatrix<double>& m, const Eigen::Matrix
 Eigen::MatrixXd solve_mass_cg(const Eigen::SparseMatrix<double>& m, const Eigen::MatrixXd& b, double tolerance,
                               int max_iterations, int* iterations, const Eigen::MatrixXd* x0,
                               int parallel_rows) {
+  CgBuffers buffers;
+  Eigen::MatrixXd x;
+  solve_mass_cg(m, b, tolerance, max_iterations, iterations, x0, parallel_rows, buffers, x);
+  return x;
+}
+
+void solve_mass_cg(const Eigen::SparseMatrix<double>& m, const Eigen::MatrixXd& b, double tolerance, int max_iterations,
+                   int* iterations, const Eigen::MatrixXd* x0, int parallel_rows, CgBuffers& buffers,
+                   Eigen::MatrixXd& x) {
   const Eigen::Index n = b.rows(), k = b.cols();
-  const Eigen::VectorXd inv_diag = m.diagonal().cwiseInverse();
+  Eigen::VectorXd& inv_diag = buffers.inv_diag;
+  Eigen::MatrixXd &r = buffers.r, &z = buffers.z, &p = buffers.p, &q = buffers.q;
+  Eigen::RowVectorXd &rz = buffers.rz, &limit = buffers.limit, &res = buffers.res;
+  inv_diag = m.diagonal().cwiseInverse();
   const bool warm = x0 && x0->rows() == n && x0->cols() == k;
-  Eigen::MatrixXd x = warm ? *x0 : Eigen::MatrixXd::Zero(n, k), r = b;
+  if (warm)
+    x = *x0;
+  else
+    x.setZero(n, k);
+  r = b;
   if (warm) {
-    Eigen::MatrixXd mx(n, k);
+    Eigen::MatrixXd& mx = buffers.mx;
+    mx.resize(n, k);
     symmetric_product(m, x, mx, parallel_rows);
     r -= mx;
   }
-  Eigen::MatrixXd z = inv_diag.asDiagonal() * r, p = z, q(n, k);
-  Eigen::RowVectorXd rz = (r.cwiseProduct(z)).colwise().sum();
-  const Eigen::RowVectorXd limit = tolerance * b.colwise().norm();
+  z.noalias() = inv_diag.asDiagonal() * r;
+  p = z;
+  q.resize(n, k);
+  rz = (r.cwiseProduct(z)).colwise().sum();
+  limit = tolerance * b.colwise().norm();
   int it = 0;
   while (true) {
-    const Eigen::RowVectorXd res = r.colwise().norm();
+    res = r.colwise().norm();
     if ((res.array() <= limit.array()).all()) break;
     if (it == max_iterations)
       throw Error("method S: the mass-matrix solve did not converge in " + std::to_string(max_iterations) +
@@ -91,7 +110,6 @@ Eigen::MatrixXd solve_mass_cg(const Eigen::SparseMatrix<double>& m, const Eigen:
     }
   }
   if (iterations) *iterations = it;
-  return x;
 }
 
 }  // namespace bendlab::loop_shell

@@ -16,20 +16,27 @@ MethodInfo MeyerMethod::info() {
   return m;
 }
 
-BendingResult MeyerMethod::compute(const Topology& topology, const Points& x, double kappa_b) const {
-  return compute_terms(topology, x, BendingParameters(kappa_b));  // plain: eq. (10) unchanged
-}
+// Kept by the method instance and reused from call to call (method_workspace.hpp).
+struct MeyerMethod::Workspace {
+  MeshGeometry geometry;
+  Points lap_x;
+};
 
-// With c0 and ADE the force law of docs/conventions.md §5 from the same H, K, Lap H and n.
-BendingResult MeyerMethod::compute_terms(const Topology& topology, const Points& x,
-                                         const BendingParameters& params) const {
-  const MeshGeometry g = MeshGeometry::compute(topology, x);
+MeyerMethod::MeyerMethod() = default;
+MeyerMethod::~MeyerMethod() = default;
+
+void MeyerMethod::fields(const Topology& topology, const Points& x, BendingResult& out) const {
+  const auto ws = workspace_.acquire();
+  MeshGeometry& g = ws->geometry;
+  MeshGeometry::compute(topology, x, g);
   // eqs. (2) and (11) with a_i = A_mixed and the MWA normal.
-  Scalars H = mean_curvature_cotan(topology, g, x, g.normal_mwa, g.mixed_area);
+  mean_curvature_cotan(topology, g, x, g.normal_mwa, g.mixed_area, ws->lap_x, out.H);
   // eq. (11) applied to H.
-  Scalars lapH = cotan_laplacian(topology, g, H, g.mixed_area);
-  return assemble_variational_result(g.normal_mwa, std::move(H), g.gaussian_curvature, std::move(lapH),
-                                     g.mixed_area, params);
+  cotan_laplacian(topology, g, out.H, g.mixed_area, out.lapH);
+  // The geometry's arrays change places with the result's (no copy; next call they are reused).
+  out.normal.swap(g.normal_mwa);
+  out.K.swap(g.gaussian_curvature);
+  out.area.swap(g.mixed_area);
 }
 
 }  // namespace bendlab

@@ -7,9 +7,19 @@
 
 namespace bendlab {
 
+// Kept by the method instance and reused from call to call (method_workspace.hpp).
+struct MixedEDMethod::Workspace {
+  MeshGeometry geometry;
+  std::vector<FarutinFit> fits;
+  FarutinWorkspace buffers;
+  BelkinLaplacian laplacian;
+};
+
 MixedEDMethod::MixedEDMethod(int rings) : rings_(rings) {
   if (rings < 1) throw Error("method ED: rings must be at least 1, got " + std::to_string(rings));
 }
+
+MixedEDMethod::~MixedEDMethod() = default;
 
 std::unique_ptr<BendingMethod> MixedEDMethod::create(const MethodOptions& options) {
   return std::make_unique<MixedEDMethod>(parse_farutin_rings(options, "ED"));
@@ -22,20 +32,17 @@ MethodInfo MixedEDMethod::info() {
   return m;
 }
 
-BendingResult MixedEDMethod::compute(const Topology& topology, const Points& x, double kappa_b) const {
-  return compute_terms(topology, x, BendingParameters(kappa_b));  // plain: eq. (10) unchanged
-}
-
-// With c0 and ADE the force law of docs/conventions.md §5 from the same H, K, Lap H and n.
-BendingResult MixedEDMethod::compute_terms(const Topology& topology, const Points& x,
-                                           const BendingParameters& params) const {
-  const MeshGeometry geometry = MeshGeometry::compute(topology, x);
-  const std::vector<FarutinFit> fits = farutin_fit(topology, x, geometry.normal_mwa, rings_);
-  require_valid_fits(fits, "ED");
-  FarutinFields e = farutin_fields(fits);
-  Scalars lapH = belkin_laplacian(topology, x, geometry, e.H);
-  return assemble_variational_result(std::move(e.normal), std::move(e.H), std::move(e.K), std::move(lapH),
-                                     geometry.mixed_area, params);
+void MixedEDMethod::fields(const Topology& topology, const Points& x, BendingResult& out) const {
+  const auto ws = workspace_.acquire();
+  MeshGeometry& geometry = ws->geometry;
+  MeshGeometry::compute(topology, x, geometry);
+  farutin_fit(topology, x, geometry.normal_mwa, rings_, ws->buffers, ws->fits);
+  require_valid_fits(ws->fits, "ED");
+  farutin_fields(ws->fits, out.normal, out.H, out.K);
+  // belkin_laplacian(topology, x, geometry, H) with the operator's buffers kept.
+  ws->laplacian.prepare(topology, x, geometry, BelkinOptions{});
+  ws->laplacian.apply_into(out.H, out.lapH);
+  out.area.swap(geometry.mixed_area);  // no copy; next call the arrays are reused
 }
 
 }  // namespace bendlab

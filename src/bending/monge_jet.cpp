@@ -8,6 +8,8 @@
 #include <limits>
 #include <mutex>
 
+#include <omp.h>
+
 #include "bendlab/bending/monge_jet_solve.hpp"
 #include "bendlab/bending/variational_assembly.hpp"
 #include "bendlab/geometry/mesh_geometry.hpp"
@@ -328,19 +330,53 @@ std::vector<MongeJetFit> monge_jet_fit(const Topology& t, const Points& x, const
 
 std::vector<MongeJetFit> monge_jet_fit(const Topology& t, const Points& x, const Points& mwa_normal,
                                        const MongeJetSettings& settings, const MongeJetSupports& lists) {
+  MongeJetWorkspace ws;
+  std::vector<MongeJetFit> fits;
+  monge_jet_fit(t, x, mwa_normal, settings, lists, ws, fits);
+  return fits;
+}
+
+// One thread's buffers: its neighbourhood (for one topology), the supports of a batch of nodes.
+struct MongeJetWorkspace::Thread {
+  explicit Thread(const Topology& t) : topology(&t), nb(t) {}
+  const Topology* topology;
+  VertexRings nb;
+  std::vector<Vec3> buffer;
+  std::array<std::vector<Vec3>, kJetLanes> supports;
+  std::array<MongeJetNode, kJetLanes> nodes;
+};
+
+MongeJetWorkspace::MongeJetWorkspace() = default;
+MongeJetWorkspace::~MongeJetWorkspace() = default;
+
+void MongeJetWorkspace::prepare() {
+  const auto n = static_cast<std::size_t>(omp_get_max_threads());
+  if (threads_.size() < n) threads_.resize(n);
+}
+
+MongeJetWorkspace::Thread& MongeJetWorkspace::thread(int k, const Topology& topology) {
+  std::unique_ptr<Thread>& slot = threads_[k];
+  if (!slot || slot->topology != &topology) slot = std::make_unique<Thread>(topology);
+  return *slot;
+}
+
+void monge_jet_fit(const Topology& t, const Points& x, const Points& mwa_normal, const MongeJetSettings& settings,
+                   const MongeJetSupports& lists, MongeJetWorkspace& ws, std::vector<MongeJetFit>& fits) {
   check_settings(settings);
   if (!lists.matches(t, settings))
     throw Error("method M: the support lists were built for another mesh connectivity or other options");
   const int n = t.num_vertices();
-  std::vector<MongeJetFit> fits(n);
+  fits.resize(n);
   // kJetLanes nodes at a time: their supports one by one, their fits side by side (fit_lanes).
   const int batches = (n + kJetLanes - 1) / kJetLanes;
+  ws.prepare();
 #pragma omp parallel
   {
-    VertexRings nb(t);
-    std::vector<Vec3> buffer;
-    std::array<std::vector<Vec3>, kJetLanes> supports;
-    std::array<MongeJetNode, kJetLanes> nodes;
+    MongeJetWorkspace::Thread& scratch = ws.thread(omp_get_thread_num(), t);
+    VertexRings& nb = scratch.nb;
+    std::vector<Vec3>& buffer = scratch.buffer;
+    std::array<std::vector<Vec3>, kJetLanes>& supports = scratch.supports;
+    std::array<MongeJetNode, kJetLanes>& nodes = scratch.nodes;
 #pragma omp for schedule(static)
     for (int b = 0; b < batches; ++b) {
       const int first = b * kJetLanes, count = std::min(kJetLanes, n - first);
@@ -388,10 +424,17 @@ std::vector<MongeJetFit> monge_jet_fit(const Topology& t, const Points& x, const
                             "(singular least-squares system, even with every vertex the mesh connects to it)",
                             settings.degree, i, f.points));
   }
-  return fits;
 }
 
+// Kept by the method instance and reused from call to call (method_workspace.hpp).
+struct MongeJetMethod::Workspace {
+  MeshGeometry geometry;
+  std::vector<MongeJetFit> fits;
+  MongeJetWorkspace buffers;
+};
+
 MongeJetMethod::MongeJetMethod(MongeJetSettings settings) : settings_(settings) { check_settings(settings_); }
+MongeJetMethod::~MongeJetMethod() = default;
 
 std::shared_ptr<const MongeJetSupports> MongeJetMethod::supports_for(const Topology& topology) const {
   {
@@ -437,26 +480,25 @@ MethodInfo MongeJetMethod::info() {
   return m;
 }
 
-BendingResult MongeJetMethod::compute(const Topology& topology, const Points& x, double kappa_b) const {
-  return compute_terms(topology, x, BendingParameters(kappa_b));  // plain: eq. (10) unchanged
-}
-
-// With c0 and ADE the force law of docs/conventions.md §5 from the same H, K, Lap H and n.
-BendingResult MongeJetMethod::compute_terms(const Topology& topology, const Points& x,
-                                            const BendingParameters& params) const {
-  const MeshGeometry geometry = MeshGeometry::compute(topology, x);
-  const std::vector<MongeJetFit> fits = monge_jet_fit(topology, x, geometry.normal_mwa, settings_, *supports_for(topology));
+void MongeJetMethod::fields(const Topology& topology, const Points& x, BendingResult& out) const {
+  const std::shared_ptr<const MongeJetSupports> supports = supports_for(topology);
+  const auto ws = workspace_.acquire();
+  MeshGeometry& geometry = ws->geometry;
+  MeshGeometry::compute(topology, x, geometry);
+  monge_jet_fit(topology, x, geometry.normal_mwa, settings_, *supports, ws->buffers, ws->fits);
+  const std::vector<MongeJetFit>& fits = ws->fits;
   const auto n = static_cast<Eigen::Index>(fits.size());
-  Points normal(n, 3);
-  Scalars H(n), K(n), lapH(n);
+  out.normal.resize(n, 3);
+  out.H.resize(n);
+  out.K.resize(n);
+  out.lapH.resize(n);
   for (Eigen::Index i = 0; i < n; ++i) {
-    normal.row(i) = fits[i].normal.transpose();
-    H[i] = fits[i].H;
-    K[i] = fits[i].K;
-    lapH[i] = fits[i].lapH;
+    out.normal.row(i) = fits[i].normal.transpose();
+    out.H[i] = fits[i].H;
+    out.K[i] = fits[i].K;
+    out.lapH[i] = fits[i].lapH;
   }
-  return assemble_variational_result(std::move(normal), std::move(H), std::move(K), std::move(lapH),
-                                     geometry.mixed_area, params);
+  out.area.swap(geometry.mixed_area);  // no copy; next call the arrays are reused
 }
 
 }  // namespace bendlab

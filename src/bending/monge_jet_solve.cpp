@@ -124,7 +124,7 @@ __attribute__((always_inline)) inline void solve_body(const double* xi, const do
   for (int l = 0; l < L; ++l) determined[l] = min_pivot[l] > kJetMinPivotRatio * max_diag[l];
 }
 
-// Compiled for AVX-512, AVX2+FMA and baseline x86-64 and picked at run time (as belkin.cpp's and
+// Compiled for AVX-512, AVX2+FMA and baseline x86-64 and picked at run time (as belkin_kernel.cpp's and
 // the boundary integral's kernels).
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
 #define BENDLAB_JET_CLONES __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))

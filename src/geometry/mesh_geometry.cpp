@@ -5,9 +5,14 @@
 namespace bendlab {
 
 MeshGeometry MeshGeometry::compute(const Topology& t, const Points& x) {
+  MeshGeometry g;
+  compute(t, x, g);
+  return g;
+}
+
+void MeshGeometry::compute(const Topology& t, const Points& x, MeshGeometry& g) {
   const int nf = t.num_faces(), nv = t.num_vertices(), ne = t.num_edges();
   const Faces& F = t.faces();
-  MeshGeometry g;
   g.face_area.resize(nf);
   g.face_normal.resize(nf, 3);
   g.corner_angle.resize(nf, 3);
@@ -19,7 +24,10 @@ MeshGeometry MeshGeometry::compute(const Topology& t, const Points& x) {
   g.normal_mwa.resize(nv, 3);
   g.gaussian_curvature.resize(nv);
   // Each corner's share of the Voronoi and of the mixed area, gathered per vertex below.
-  CornerValues corner_voronoi(nf, 3), corner_mixed(nf, 3);
+  g.corner_voronoi.resize(nf, 3);
+  g.corner_mixed.resize(nf, 3);
+  CornerValues& corner_voronoi = g.corner_voronoi;
+  CornerValues& corner_mixed = g.corner_mixed;
 
   // Three passes, each free of write conflicts (faces, then edges, then vertices gathering over
   // their CSR ring), so they run in parallel and sum in the same order for any thread count.
@@ -91,14 +99,20 @@ MeshGeometry MeshGeometry::compute(const Topology& t, const Points& x) {
     g.mixed_area[i] = mixed;
     g.gaussian_curvature[i] = (2 * M_PI - angle) / mixed;  // eq. (12)
   }
-  return g;
 }
 
 Scalars mixed_area(const Topology& t, const Points& x) {
+  Scalars area;
+  CornerValues corner_mixed;
+  mixed_area(t, x, area, corner_mixed);
+  return area;
+}
+
+void mixed_area(const Topology& t, const Points& x, Scalars& area, CornerValues& corner_mixed) {
   const int nf = t.num_faces(), nv = t.num_vertices();
   const Faces& F = t.faces();
   // The arithmetic of MeshGeometry::compute, step for step.
-  CornerValues corner_mixed(nf, 3);
+  corner_mixed.resize(nf, 3);
 #pragma omp parallel for schedule(static)
   for (int f = 0; f < nf; ++f) {
     const Vec3 p[3] = {x.row(F(f, 0)), x.row(F(f, 1)), x.row(F(f, 2))};
@@ -121,19 +135,24 @@ Scalars mixed_area(const Topology& t, const Points& x) {
   }
   const auto& rf = t.ring_faces();
   const auto& rc = t.ring_corners();
-  Scalars area(nv);
+  area.resize(nv);
 #pragma omp parallel for schedule(static)
   for (int i = 0; i < nv; ++i) {
     double mixed = 0;
     for (int r = t.ring_begin(i); r < t.ring_end(i); ++r) mixed += corner_mixed(rf[r], rc[r]);
     area[i] = mixed;
   }
-  return area;
 }
 
 Scalars cotan_laplacian(const Topology& t, const MeshGeometry& g, const Scalars& w, const Scalars& area) {
+  Scalars out;
+  cotan_laplacian(t, g, w, area, out);
+  return out;
+}
+
+void cotan_laplacian(const Topology& t, const MeshGeometry& g, const Scalars& w, const Scalars& area, Scalars& out) {
   const int nv = t.num_vertices();
-  Scalars out(nv);
+  out.resize(nv);
   const auto& ring = t.ring_vertices();
   const auto& redge = t.ring_edges();
 #pragma omp parallel for schedule(static)
@@ -142,12 +161,17 @@ Scalars cotan_laplacian(const Topology& t, const MeshGeometry& g, const Scalars&
     for (int k = t.ring_begin(i); k < t.ring_end(i); ++k) s += g.edge_cot_weight[redge[k]] * (w[ring[k]] - w[i]);
     out[i] = s / (2 * area[i]);
   }
-  return out;
 }
 
 Points cotan_laplacian(const Topology& t, const MeshGeometry& g, const Points& w, const Scalars& area) {
+  Points out;
+  cotan_laplacian(t, g, w, area, out);
+  return out;
+}
+
+void cotan_laplacian(const Topology& t, const MeshGeometry& g, const Points& w, const Scalars& area, Points& out) {
   const int nv = t.num_vertices();
-  Points out(nv, 3);
+  out.resize(nv, 3);
   const auto& ring = t.ring_vertices();
   const auto& redge = t.ring_edges();
 #pragma omp parallel for schedule(static)
@@ -157,15 +181,21 @@ Points cotan_laplacian(const Topology& t, const MeshGeometry& g, const Points& w
       s += g.edge_cot_weight[redge[k]] * (w.row(ring[k]) - w.row(i));
     out.row(i) = s / (2 * area[i]);
   }
-  return out;
 }
 
 Scalars mean_curvature_cotan(const Topology& t, const MeshGeometry& g, const Points& x, const Points& normals,
                              const Scalars& area) {
-  const Points lap = cotan_laplacian(t, g, x, area);
-  Scalars H(t.num_vertices());
-  for (int i = 0; i < t.num_vertices(); ++i) H[i] = -0.5 * lap.row(i).dot(normals.row(i));
+  Points lap;
+  Scalars H;
+  mean_curvature_cotan(t, g, x, normals, area, lap, H);
   return H;
+}
+
+void mean_curvature_cotan(const Topology& t, const MeshGeometry& g, const Points& x, const Points& normals,
+                          const Scalars& area, Points& lap, Scalars& H) {
+  cotan_laplacian(t, g, x, area, lap);
+  H.resize(t.num_vertices());
+  for (int i = 0; i < t.num_vertices(); ++i) H[i] = -0.5 * lap.row(i).dot(normals.row(i));
 }
 
 }  // namespace bendlab

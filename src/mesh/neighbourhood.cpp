@@ -26,9 +26,15 @@ void VertexRings::start(int i) {
 
 bool VertexRings::add_ring() {
   if (!stamped_) {  // marks are only needed beyond ring 1, so ring-1 queries never touch them
-    if (mark_.empty()) mark_.assign(t_.num_vertices(), -1);
-    mark_[centre_] = centre_;
-    for (int j : list_) mark_[j] = centre_;
+    if (mark_.empty()) mark_.assign(t_.num_vertices(), 0);
+    // A stamp of its own for this start: marks left by an earlier visit of the same centre (the
+    // object reused from pass to pass) must not count.
+    if (++stamp_ == 0) {
+      std::fill(mark_.begin(), mark_.end(), 0u);
+      stamp_ = 1;
+    }
+    mark_[centre_] = stamp_;
+    for (int j : list_) mark_[j] = stamp_;
     stamped_ = true;
   }
   const std::size_t end = list_.size();
@@ -36,8 +42,8 @@ bool VertexRings::add_ring() {
     const int j = list_[k];
     for (int m = t_.ring_begin(j); m < t_.ring_end(j); ++m) {
       const int l = t_.ring_vertices()[m];
-      if (mark_[l] != centre_) {
-        mark_[l] = centre_;
+      if (mark_[l] != stamp_) {
+        mark_[l] = stamp_;
         list_.push_back(l);
       }
     }

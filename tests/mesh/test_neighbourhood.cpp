@@ -75,6 +75,20 @@ TEST(Neighbourhood, KRingsAreTheVerticesAtDistanceUpToK) {
   EXPECT_THROW(k_ring(t, 0, -1), Error);
 }
 
+TEST(Neighbourhood, OneObjectVisitsAVertexAgain) {
+  // One VertexRings reused from pass to pass (a method keeps one per thread between calls) gives
+  // every centre the rings k_ring gives, however often it has started there before.
+  const TriMesh m = sphere_mesh(MeshFamily::MT1, 2);
+  const Topology& t = m.topology();
+  VertexRings r(t);
+  for (int pass = 0; pass < 3; ++pass)
+    for (int i = 0; i < t.num_vertices(); i += 7) {
+      r.start(i);
+      r.grow_to(2 + pass % 2);
+      EXPECT_EQ(r.vertices(), k_ring(t, i, 2 + pass % 2)) << "pass " << pass << " vertex " << i;
+    }
+}
+
 TEST(Neighbourhood, OneRingFacesAreTheCounterClockwiseFan) {
   const TriMesh m = sphere_mesh(MeshFamily::MT2, 1);
   const Topology& t = m.topology();

@@ -12,7 +12,7 @@
 // volume centroid c whose normal points from c to x_i, i.e. (p - c).(x_i - c) > 0, take part, so
 // that nodes close in space but far along the surface (the two dimples of a red blood cell) do not
 // see each other. Points within a relative margin of 1e-9 of the plane count as on it (see
-// belkin.cpp), so that the rule does not depend on rounding for symmetric meshes.
+// belkin_kernel.hpp), so that the rule does not depend on rounding for symmetric meshes.
 //
 // Two evaluations of the same sum (BelkinOptions::neighbours, method option "neighbours"):
 //
@@ -42,7 +42,7 @@
 //   reference's exponential: 7.5e-12 at 81920; with cutoff 1e-12: 5.9e-9, too close to 1e-8.)
 //   Values below e^-80 are clamped to e^-80, the reference's own cut, so that both forms keep the
 //   same terms and differ only by the order of the sum and the exponential below.
-// Kernels (belkin.cpp), branch-free over blocks of points of a run (the exponent, the cut-off,
+// Kernels (belkin_kernel.hpp), branch-free over blocks of points of a run (the exponent, the cut-off,
 // the run's end and the half-space test as a mask) so that they vectorise (AVX-512, AVX2 or
 // baseline, chosen at run time):
 // - all: blocks of 16, exp by a polynomial within an ulp of std::exp (measured over [0, 80]).
@@ -82,10 +82,15 @@
 // Both are deterministic; they differ only by the order of the sum, the exponential and the
 // dropped terms.
 // The operator of a constant is exactly zero in both (every term carries w(p) - w(x_i) = 0).
+// Where the parts are: belkin_kernel.hpp/.cpp the per-vertex sums and their exponentials;
+// belkin_grid.cpp the cell list, the runs, the kept weights and the grid form's applies;
+// belkin_reference.cpp the all-pairs form; belkin.cpp the operator's set-up for a shape, the
+// dispatch of the applies and Method D.
 #include <memory>
 #include <vector>
 
 #include "bendlab/bending/method_registry.hpp"
+#include "bendlab/bending/variational_assembly.hpp"
 #include "bendlab/geometry/mesh_geometry.hpp"
 
 namespace bendlab {
@@ -123,6 +128,8 @@ Points belkin_laplacian(const Topology& topology, const Points& x, const MeshGeo
 /// for the grid form, the cell list) and applied to several fields, as Method D does to x and H.
 class BelkinLaplacian {
  public:
+  /// An operator for no shape yet (prepare() gives it one).
+  BelkinLaplacian() = default;
   BelkinLaplacian(const Topology& topology, const Points& x, const MeshGeometry& geometry,
                   BelkinOptions options = {});
   /// Hands the weights' memory to a spare kept per thread, which the next operator built on that
@@ -130,18 +137,26 @@ class BelkinLaplacian {
   ~BelkinLaplacian();
   BelkinLaplacian(BelkinLaplacian&&) = default;
   BelkinLaplacian& operator=(BelkinLaplacian&&) = default;
+  /// The operator of another shape (what the constructor does), in this operator's buffers: no
+  /// allocation once they are large enough (a method keeps its operator from call to call).
+  void prepare(const Topology& topology, const Points& x, const MeshGeometry& geometry, BelkinOptions options = {});
   Scalars apply(const Scalars& w) const;
   Points apply(const Points& w) const;
   /// Lap x: the operator applied to the positions it was built from (equal to apply(x) up to
   /// rounding; the grid form reuses the differences p - x_i its kernel computes anyway).
   Points apply_to_positions() const;
+  /// The same three into `out` (resized), with the operator's own scratch buffers: the same values,
+  /// no allocation once warm, but not for concurrent use of one operator (apply() is).
+  void apply_into(const Scalars& w, Scalars& out);
+  void apply_into(const Points& w, Points& out);
+  void apply_to_positions_into(Points& out);
   /// Lumped weight of vertex p: one third of the area of the faces at p.
   const Scalars& lumped_area() const { return lumped_area_; }
 
  private:
   template <int Cols>
-  void apply_columns(const double* const* w, double* const* out) const;
-  void apply_grid(const double* w, double* const* out) const;
+  void apply_columns(const double* const* w, double* const* out, std::vector<double>& buffer) const;
+  void apply_grid(const double* w, double* const* out, std::vector<double>& buffer) const;
   void build_grid();
   void cache_weights();
   /// Array j of the points in scan order (0, 1, 2: centred position; 3: |x_p - c|; 4: lumped
@@ -170,24 +185,39 @@ class BelkinLaplacian {
   /// Grid form: 1 where vertex i's ball crosses the half-space plane (the kernel tests each
   /// point), 0 where every point within its cut-off radius lies above it.
   std::vector<unsigned char> plane_test_;
-  /// Grid form, when they fit options.weight_cache_bytes (else null): the kernel weights
-  /// A_p exp(-|p - x_i|^2 / (4 a_i)) of every lane of every block vertex i scans (zero where a
-  /// term is dropped), from weight_start_[i], so that Lap x and Lap H evaluate each exponential once.
+  /// Grid form, when they fit options.weight_cache_bytes (else has_weights_ is false): the kernel
+  /// weights A_p exp(-|p - x_i|^2 / (4 a_i)) of every lane of every block vertex i scans (zero
+  /// where a term is dropped), from weight_start_[i], so that Lap x and Lap H evaluate each
+  /// exponential once. The buffer is kept from shape to shape.
   struct WeightBuffer {
     std::unique_ptr<double[]> data;
     std::size_t capacity = 0;
   };
   WeightBuffer weights_;
+  bool has_weights_ = false;
   std::vector<std::size_t> weight_start_;
   /// Lap x, summed in the same pass as the weights (apply_to_positions() returns it then).
   Points lap_positions_;
+  /// build_grid's buffers, kept from shape to shape: cut-off radii, cell of each point, cell
+  /// starts, fill positions, each thread's runs.
+  struct GridBuffers {
+    std::vector<double> radius, sorted;
+    std::vector<int> cell_of, cell_start, fill;
+    std::vector<std::vector<int>> parts;
+  };
+  GridBuffers grid_buffers_;
+  /// The *_into functions' buffers: a field in scan order, column-major copies of a vector field.
+  std::vector<double> field_buffer_;
+  Eigen::MatrixXd columns_in_, columns_out_;
+  Points positions_buffer_;
 };
 
 /// Method D: normal = MWA; H by eq. (2) with eq. (13) (H = -1/2 (Lap x) . n); lapH by eq. (13)
 /// applied to H; K by eq. (12); f by eq. (10); F = f A_mixed (eq. (14)); no energy.
-class BelkinMethod final : public BendingMethod {
+class BelkinMethod final : public VariationalMethod {
  public:
-  explicit BelkinMethod(BelkinOptions options = {}) : options_(options) {}
+  explicit BelkinMethod(BelkinOptions options = {});
+  ~BelkinMethod() override;
   /// Options: "neighbours" = "grid" (default) | "all", "kernel_cutoff" = a number in [1e-300, 0.5]
   /// (default 1e-15); see BelkinOptions. Any other option is an error (bendlab::Error naming it).
   static std::unique_ptr<BendingMethod> create(const MethodOptions& options);
@@ -196,15 +226,16 @@ class BelkinMethod final : public BendingMethod {
   const BelkinOptions& options() const { return options_; }
 
   std::string name() const override { return "D"; }
-  BendingResult compute(const Topology& topology, const Points& x, double kappa_b) const override;
 
  protected:
-  /// c0 and ADE through the force law of docs/conventions.md §5 (variational_assembly.hpp).
-  bool supports_membrane_terms() const override { return true; }
-  BendingResult compute_terms(const Topology& topology, const Points& x, const BendingParameters& params) const override;
+  /// n, H, K, lapH and the mixed area; eq. (10) and c0 / ADE are VariationalMethod's.
+  void fields(const Topology& topology, const Points& x, BendingResult& out) const override;
 
  private:
   BelkinOptions options_;
+  struct Workspace;
+  /// The geometry, the operator (cell list, weights) and Lap x of the last call, kept between calls.
+  MethodWorkspace<Workspace> workspace_;
 };
 
 }  // namespace bendlab

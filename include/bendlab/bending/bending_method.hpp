@@ -38,7 +38,14 @@ class BendingMethod {
   virtual std::string name() const = 0;
   /// Every per-vertex quantity of the method.
   virtual BendingResult compute(const Topology& topology, const Points& x, double kappa_b) const = 0;
-  /// Node forces F only (what a flow solver needs); the default calls compute().
+  /// The same into `out`, whose arrays are reused: the built-in methods allocate nothing once warm
+  /// (the same instance, mesh and `out` as the call before; method_workspace.hpp), the values are
+  /// those of compute() bit for bit. The default assigns compute()'s result.
+  virtual void compute_into(const Topology& topology, const Points& x, double kappa_b, BendingResult& out) const {
+    out = compute(topology, x, kappa_b);
+  }
+  /// Node forces F only (what a flow solver needs); the default calls compute(). The built-in
+  /// methods allocate nothing once warm (same instance and mesh, `force` already N x 3).
   virtual void forces(const Topology& topology, const Points& x, double kappa_b, Points& force) const {
     force = compute(topology, x, kappa_b).force;
   }
@@ -52,6 +59,8 @@ class BendingMethod {
 
   /// Every per-vertex quantity with the energy of `p`.
   BendingResult compute(const Topology& topology, const Points& x, const BendingParameters& p) const;
+  /// The same into `out` (see compute_into above).
+  void compute_into(const Topology& topology, const Points& x, const BendingParameters& p, BendingResult& out) const;
   /// Node forces only.
   void forces(const Topology& topology, const Points& x, const BendingParameters& p, Points& force) const;
   /// E = 2 kB ∫ (H - c0)^2 dA + E_ADE for energy-based methods, std::nullopt otherwise.
@@ -66,6 +75,11 @@ class BendingMethod {
   /// Why not, for the error message (docs/conventions.md §5).
   virtual std::string membrane_terms_refusal() const;
   virtual BendingResult compute_terms(const Topology& topology, const Points& x, const BendingParameters& p) const;
+  /// Default: out = compute_terms(...).
+  virtual void compute_terms_into(const Topology& topology, const Points& x, const BendingParameters& p,
+                                  BendingResult& out) const {
+    out = compute_terms(topology, x, p);
+  }
   /// Default: compute_terms(...).force.
   virtual void forces_terms(const Topology& topology, const Points& x, const BendingParameters& p,
                             Points& force) const {

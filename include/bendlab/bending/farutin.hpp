@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "bendlab/bending/method_registry.hpp"
+#include "bendlab/bending/variational_assembly.hpp"
 #include "bendlab/core/types.hpp"
 #include "bendlab/geometry/mesh_geometry.hpp"
 #include "bendlab/mesh/topology.hpp"
@@ -63,6 +64,29 @@ double farutin_laplacian_point(const FarutinFit& fit, const Vec3& x0, std::span<
 std::vector<FarutinFit> farutin_fit(const Topology& topology, const Points& x, const Points& normal_guess,
                                     int rings);
 
+/// Buffers of farutin_fit and farutin_laplacian (each thread's neighbourhood, built for one
+/// topology), kept by a method from call to call so that the fits allocate nothing once warm.
+class FarutinWorkspace {
+ public:
+  FarutinWorkspace();
+  ~FarutinWorkspace();
+  FarutinWorkspace(const FarutinWorkspace&) = delete;
+  FarutinWorkspace& operator=(const FarutinWorkspace&) = delete;
+  struct Thread;
+  /// Thread k's buffers for `topology` (made on first use, or when the topology changes); call
+  /// prepare() before the parallel region.
+  Thread& thread(int k, const Topology& topology);
+  /// Room for omp_get_max_threads() threads.
+  void prepare();
+
+ private:
+  std::vector<std::unique_ptr<Thread>> threads_;
+};
+
+/// The same fits into `fits` (resized), with the buffers of `ws`.
+void farutin_fit(const Topology& topology, const Points& x, const Points& normal_guess, int rings,
+                 FarutinWorkspace& ws, std::vector<FarutinFit>& fits);
+
 /// Throws bendlab::Error naming `method` and the first vertex whose fit is invalid: no support
 /// the mesh offers determines its paraboloid (the bare octahedron, for instance, where every
 /// neighbourhood is symmetric enough to leave the xy term free). Called before any further work.
@@ -71,6 +95,9 @@ void require_valid_fits(const std::vector<FarutinFit>& fits, std::string_view me
 /// Lap w at every node on the neighbourhoods and charts of `fits` (NaN where a fit is invalid).
 Scalars farutin_laplacian(const Topology& topology, const Points& x, const std::vector<FarutinFit>& fits,
                           const Scalars& w);
+/// The same into `out` (resized), with the buffers of `ws`.
+void farutin_laplacian(const Topology& topology, const Points& x, const std::vector<FarutinFit>& fits,
+                       const Scalars& w, FarutinWorkspace& ws, Scalars& out);
 
 /// Normal, H and K of every node, in vertex order (NaN where a fit is invalid).
 struct FarutinFields {
@@ -78,6 +105,8 @@ struct FarutinFields {
   Scalars H, K;
 };
 FarutinFields farutin_fields(const std::vector<FarutinFit>& fits);
+/// The same into the three arrays (resized).
+void farutin_fields(const std::vector<FarutinFit>& fits, Points& normal, Scalars& H, Scalars& K);
 
 /// The schema of the option "rings" (integer 1..3, default 1), shared by Methods E and ED.
 OptionSpec farutin_rings_option();
@@ -86,26 +115,28 @@ OptionSpec farutin_rings_option();
 int parse_farutin_rings(const MethodOptions& options, const std::string& method);
 
 /// Method E.
-class FarutinMethod : public BendingMethod {
+class FarutinMethod : public VariationalMethod {
  public:
   explicit FarutinMethod(int rings = 1);
+  ~FarutinMethod() override;
   static std::unique_ptr<BendingMethod> create(const MethodOptions& options);
   /// The method's entry in the registry (method_registry.hpp): description, options, capabilities.
   static MethodInfo info();
 
   std::string name() const override { return "E"; }
-  BendingResult compute(const Topology& topology, const Points& x, double kappa_b) const override;
 
  protected:
-  /// c0 and ADE through the force law of docs/conventions.md §5 (variational_assembly.hpp).
-  bool supports_membrane_terms() const override { return true; }
-  BendingResult compute_terms(const Topology& topology, const Points& x, const BendingParameters& params) const override;
+  /// n, H, K, lapH from the fits and the mixed area; eq. (10) and c0 / ADE are VariationalMethod's.
+  void fields(const Topology& topology, const Points& x, BendingResult& out) const override;
 
  public:
   int rings() const { return rings_; }
 
  private:
   int rings_;
+  struct Workspace;
+  /// The geometry, the fits and their buffers of the last call, kept between calls.
+  MethodWorkspace<Workspace> workspace_;
 };
 
 }  // namespace bendlab

@@ -17,12 +17,14 @@
 #include <memory>
 
 #include "bendlab/bending/method_registry.hpp"
+#include "bendlab/bending/method_workspace.hpp"
 
 namespace bendlab {
 
 class GompperKroll : public BendingMethod {
  public:
-  GompperKroll() = default;
+  GompperKroll();
+  ~GompperKroll() override;
   /// Method B has no options; throws bendlab::Error for any option given.
   static std::unique_ptr<BendingMethod> create(const MethodOptions& options);
   /// The method's entry in the registry (method_registry.hpp): description, options, capabilities.
@@ -31,6 +33,7 @@ class GompperKroll : public BendingMethod {
   std::string name() const override { return "B"; }
 
   BendingResult compute(const Topology& topology, const Points& x, double kappa_b) const override;
+  void compute_into(const Topology& topology, const Points& x, double kappa_b, BendingResult& out) const override;
   void forces(const Topology& topology, const Points& x, double kappa_b, Points& force) const override;
   std::optional<double> energy(const Topology& topology, const Points& x, double kappa_b) const override;
 
@@ -40,10 +43,17 @@ class GompperKroll : public BendingMethod {
   /// its exact gradient (gompper_kroll.cpp). H in the result has that sign.
   bool supports_membrane_terms() const override { return true; }
   BendingResult compute_terms(const Topology& topology, const Points& x, const BendingParameters& p) const override;
+  void compute_terms_into(const Topology& topology, const Points& x, const BendingParameters& p,
+                          BendingResult& out) const override;
   void forces_terms(const Topology& topology, const Points& x, const BendingParameters& p,
                     Points& force) const override;
   std::optional<double> energy_terms(const Topology& topology, const Points& x,
                                      const BendingParameters& p) const override;
+
+ private:
+  struct Workspace;
+  /// The kernel's scratch arrays, its per-vertex sums and compute()'s geometry, kept between calls.
+  MethodWorkspace<Workspace> workspace_;
 };
 
 }  // namespace bendlab

@@ -25,11 +25,14 @@
 #include <memory>
 
 #include "bendlab/bending/method_registry.hpp"
+#include "bendlab/bending/method_workspace.hpp"
 
 namespace bendlab {
 
 class JulicherMethod : public BendingMethod {
  public:
+  JulicherMethod();
+  ~JulicherMethod() override;
   /// Takes no options: throws bendlab::Error on any.
   static std::unique_ptr<BendingMethod> create(const MethodOptions& options);
   /// The method's entry in the registry (method_registry.hpp).
@@ -37,6 +40,7 @@ class JulicherMethod : public BendingMethod {
 
   std::string name() const override { return "J"; }
   BendingResult compute(const Topology& topology, const Points& x, double kappa_b) const override;
+  void compute_into(const Topology& topology, const Points& x, double kappa_b, BendingResult& out) const override;
   void forces(const Topology& topology, const Points& x, double kappa_b, Points& force) const override;
   std::optional<double> energy(const Topology& topology, const Points& x, double kappa_b) const override;
 
@@ -45,10 +49,17 @@ class JulicherMethod : public BendingMethod {
   /// M = sum_i H_i A_i = 1/2 sum_e l_e theta_e, and its exact gradient.
   bool supports_membrane_terms() const override { return true; }
   BendingResult compute_terms(const Topology& topology, const Points& x, const BendingParameters& p) const override;
+  void compute_terms_into(const Topology& topology, const Points& x, const BendingParameters& p,
+                          BendingResult& out) const override;
   void forces_terms(const Topology& topology, const Points& x, const BendingParameters& p,
                     Points& force) const override;
   std::optional<double> energy_terms(const Topology& topology, const Points& x,
                                      const BendingParameters& p) const override;
+
+ private:
+  struct Workspace;
+  /// The kernel's per-face, per-edge and per-vertex arrays and compute()'s geometry, kept between calls.
+  MethodWorkspace<Workspace> workspace_;
 };
 
 }  // namespace bendlab

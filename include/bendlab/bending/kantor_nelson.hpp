@@ -20,12 +20,14 @@
 #include <memory>
 
 #include "bendlab/bending/method_registry.hpp"
+#include "bendlab/bending/method_workspace.hpp"
 
 namespace bendlab {
 
 class KantorNelson : public BendingMethod {
  public:
-  explicit KantorNelson(bool small_angle = false) : small_angle_(small_angle) {}
+  explicit KantorNelson(bool small_angle = false);
+  ~KantorNelson() override;
   /// Options: "small_angle" = true|false|1|0. Throws bendlab::Error on any other option or value.
   static std::unique_ptr<BendingMethod> create(const MethodOptions& options);
   /// The method's entry in the registry (method_registry.hpp): description, options, capabilities.
@@ -35,12 +37,15 @@ class KantorNelson : public BendingMethod {
   bool small_angle() const { return small_angle_; }
 
   BendingResult compute(const Topology& topology, const Points& x, double kappa_b) const override;
+  void compute_into(const Topology& topology, const Points& x, double kappa_b, BendingResult& out) const override;
   void forces(const Topology& topology, const Points& x, double kappa_b, Points& force) const override;
   std::optional<double> energy(const Topology& topology, const Points& x, double kappa_b) const override;
 
  private:
+  struct Workspace;
   /// Fills force (resized to N x 3) and returns the energy.
-  double energy_and_forces(const Topology& topology, const Points& x, double kappa_b, Points& force) const;
+  double energy_and_forces(const Topology& topology, const Points& x, double kappa_b, Points& force,
+                           Workspace& ws) const;
 
  protected:
   /// A is refused c0 and ADE (docs/conventions.md §5): see membrane_terms_refusal().
@@ -48,6 +53,8 @@ class KantorNelson : public BendingMethod {
 
  private:
   bool small_angle_;
+  /// The kernel's scratch arrays and compute()'s geometry, kept between calls.
+  MethodWorkspace<Workspace> workspace_;
 };
 
 }  // namespace bendlab

@@ -44,6 +44,7 @@
 #include "bendlab/bending/bending_method.hpp"
 #include "bendlab/bending/loop_shell_energy.hpp"
 #include "bendlab/bending/method_registry.hpp"
+#include "bendlab/bending/method_workspace.hpp"
 
 namespace bendlab {
 
@@ -74,6 +75,7 @@ class LoopShellMethod final : public BendingMethod {
 
   std::string name() const override { return "S"; }
   BendingResult compute(const Topology& topology, const Points& x, double kappa_b) const override;
+  void compute_into(const Topology& topology, const Points& x, double kappa_b, BendingResult& out) const override;
   void forces(const Topology& topology, const Points& x, double kappa_b, Points& force) const override;
   std::optional<double> energy(const Topology& topology, const Points& x, double kappa_b) const override;
 
@@ -82,6 +84,8 @@ class LoopShellMethod final : public BendingMethod {
   /// M = int H dA, exact gradient on the control points (loop_shell_energy.hpp), f from the weak form.
   bool supports_membrane_terms() const override { return true; }
   BendingResult compute_terms(const Topology& topology, const Points& x, const BendingParameters& p) const override;
+  void compute_terms_into(const Topology& topology, const Points& x, const BendingParameters& p,
+                          BendingResult& out) const override;
   void forces_terms(const Topology& topology, const Points& x, const BendingParameters& p,
                     Points& force) const override;
   std::optional<double> energy_terms(const Topology& topology, const Points& x,
@@ -105,14 +109,18 @@ class LoopShellMethod final : public BendingMethod {
 
  private:
   struct Cache;
+  struct Workspace;
   std::shared_ptr<Cache> cache_for(const Topology& topology) const;
-  BendingResult evaluate(const Topology& topology, const Points& x, const BendingParameters& p,
-                         bool nodal_geometry) const;
+  /// Steps 1-4 into r; with nodal_geometry the limit surface's n, H and K too (else NaN).
+  void evaluate(const Topology& topology, const Points& x, const BendingParameters& p, bool nodal_geometry,
+                BendingResult& r, Workspace& ws) const;
   /// The energy's coefficients for `p` at control points P (M = int H dA of the limit surface for ADE).
   loop_shell::ShellTerms shell_terms(Cache& cache, const Points& control, const BendingParameters& p,
                                      double* ade_energy) const;
   /// M X = B with the chosen solver.
   Eigen::MatrixXd solve_mass(Cache& cache, const Eigen::SparseMatrix<double>& m, const Eigen::MatrixXd& b) const;
+  /// The same into ws's solution, with its buffers.
+  void solve_mass(Cache& cache, const Eigen::SparseMatrix<double>& m, const Eigen::MatrixXd& b, Workspace& ws) const;
 
   Control control_;
   int gauss_points_;
@@ -120,6 +128,9 @@ class LoopShellMethod final : public BendingMethod {
   Solver solver_;
   mutable std::mutex cache_mutex_;
   mutable std::unordered_map<const Topology*, std::shared_ptr<Cache>> cache_;
+  /// The control points, gradient, mass matrix values, solves' buffers and forces()'s result of
+  /// the last call, kept between calls (method_workspace.hpp).
+  MethodWorkspace<Workspace> workspace_;
 };
 
 }  // namespace bendlab

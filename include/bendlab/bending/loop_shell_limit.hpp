@@ -11,7 +11,10 @@
 //                   v = w = 1e-3 (the EV corner is u = 1) is reported.
 #include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
+#include <map>
+#include <utility>
 
+#include "bendlab/bending/loop_shell_basis.hpp"
 #include "bendlab/bending/loop_shell_patches.hpp"
 #include "bendlab/core/types.hpp"
 #include "bendlab/mesh/topology.hpp"
@@ -33,17 +36,36 @@ class LimitSolver {
  public:
   explicit LimitSolver(const Topology& topology);
   Points solve(const Points& x) const;
+  /// The same into p (resized), with the buffers `rhs` and `work`: the same arithmetic as
+  /// Eigen's SimplicialLDLT::solve, whose in-place permutations would allocate at every call.
+  void solve(const Points& x, Points& p, Eigen::MatrixXd& rhs, Eigen::MatrixXd& work) const;
 
  private:
   Eigen::VectorXd inv_chi_;
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt_;
+  Eigen::VectorXd inv_d_;  ///< 1 / D of the factorisation (vectorD() returns a copy)
 };
 
 /// Outward unit normals of the limit surface at the limit points of the nodes.
 Points limit_normals(const Topology& topology, const Points& control);
+/// The same into `normal` (resized).
+void limit_normals(const Topology& topology, const Points& control, Points& normal);
+
+/// The patch bases limit_curvatures evaluates: they depend on the connectivity only, so a caller
+/// evaluating many shapes of one mesh builds them once (Method S keeps them per topology).
+struct LimitCurvatureBases {
+  /// (valence of the patch, local corner 0 / 1 / 2): the basis at u = 1, v = 1 or w = 1.
+  std::map<std::pair<int, int>, PatchBasis> corner;
+  /// Valence of an extraordinary node: the basis at v = w = kExtraordinarySample.
+  std::map<int, PatchBasis> near_ev;
+  static LimitCurvatureBases build(const Topology& topology, const LoopPatches& patches);
+};
 
 /// H and K of the limit surface at the nodes' limit points (see the header comment).
 void limit_curvatures(const Topology& topology, const LoopPatches& patches, const Points& control, Scalars& H,
                       Scalars& K);
+/// The same with the bases built beforehand (no allocation when H and K have the size).
+void limit_curvatures(const Topology& topology, const LoopPatches& patches, const LimitCurvatureBases& bases,
+                      const Points& control, Scalars& H, Scalars& K);
 
 }  // namespace bendlab::loop_shell

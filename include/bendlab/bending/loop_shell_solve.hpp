@@ -19,4 +19,16 @@ Eigen::MatrixXd solve_mass_cg(const Eigen::SparseMatrix<double>& m, const Eigen:
                               int max_iterations, int* iterations = nullptr, const Eigen::MatrixXd* x0 = nullptr,
                               int parallel_rows = 2000);
 
+/// The iteration's vectors, kept by a caller that solves again and again (Method S's workspace).
+struct CgBuffers {
+  Eigen::VectorXd inv_diag;
+  Eigen::MatrixXd r, mx, z, p, q;
+  Eigen::RowVectorXd rz, limit, res;
+};
+/// The same solve into x (resized), with the buffers of `buffers`: no allocation once they have
+/// the sizes of M and B. x0 must not be x.
+void solve_mass_cg(const Eigen::SparseMatrix<double>& m, const Eigen::MatrixXd& b, double tolerance, int max_iterations,
+                   int* iterations, const Eigen::MatrixXd* x0, int parallel_rows, CgBuffers& buffers,
+                   Eigen::MatrixXd& x);
+
 }  // namespace bendlab::loop_shell

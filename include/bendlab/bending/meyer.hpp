@@ -15,23 +15,29 @@
 #include <memory>
 
 #include "bendlab/bending/method_registry.hpp"
+#include "bendlab/bending/variational_assembly.hpp"
 
 namespace bendlab {
 
-class MeyerMethod final : public BendingMethod {
+class MeyerMethod final : public VariationalMethod {
  public:
+  MeyerMethod();
+  ~MeyerMethod() override;
   /// Method C has no options; any option is an error (bendlab::Error naming it).
   static std::unique_ptr<BendingMethod> create(const MethodOptions& options);
   /// The method's entry in the registry (method_registry.hpp): description, options, capabilities.
   static MethodInfo info();
 
   std::string name() const override { return "C"; }
-  BendingResult compute(const Topology& topology, const Points& x, double kappa_b) const override;
 
  protected:
-  /// c0 and ADE through the force law of docs/conventions.md §5 (variational_assembly.hpp).
-  bool supports_membrane_terms() const override { return true; }
-  BendingResult compute_terms(const Topology& topology, const Points& x, const BendingParameters& params) const override;
+  /// n, H, K, lapH and the mixed area; eq. (10) and c0 / ADE are VariationalMethod's.
+  void fields(const Topology& topology, const Points& x, BendingResult& out) const override;
+
+ private:
+  struct Workspace;
+  /// The geometry and Lap x of the last call, kept between calls.
+  MethodWorkspace<Workspace> workspace_;
 };
 
 }  // namespace bendlab

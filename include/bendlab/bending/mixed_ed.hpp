@@ -7,31 +7,35 @@
 #include <memory>
 
 #include "bendlab/bending/method_registry.hpp"
+#include "bendlab/bending/variational_assembly.hpp"
 
 namespace bendlab {
 
-class MixedEDMethod : public BendingMethod {
+class MixedEDMethod : public VariationalMethod {
  public:
   /// rings: neighbourhood of E's fit (option "rings", 1, 2 or 3).
   explicit MixedEDMethod(int rings = 1);
+  ~MixedEDMethod() override;
   /// Option "rings" (1, 2, 3; default 1); throws bendlab::Error for any other option or value.
   static std::unique_ptr<BendingMethod> create(const MethodOptions& options);
   /// The method's entry in the registry (method_registry.hpp): description, options, capabilities.
   static MethodInfo info();
 
   std::string name() const override { return "ED"; }
-  BendingResult compute(const Topology& topology, const Points& x, double kappa_b) const override;
 
  protected:
-  /// c0 and ADE through the force law of docs/conventions.md §5 (variational_assembly.hpp).
-  bool supports_membrane_terms() const override { return true; }
-  BendingResult compute_terms(const Topology& topology, const Points& x, const BendingParameters& params) const override;
+  /// n, H, K from E's fits, lapH from D's operator, the mixed area; eq. (10) and c0 / ADE are
+  /// VariationalMethod's.
+  void fields(const Topology& topology, const Points& x, BendingResult& out) const override;
 
  public:
   int rings() const { return rings_; }
 
  private:
   int rings_;
+  struct Workspace;
+  /// The geometry, the fits and the heat-kernel operator of the last call, kept between calls.
+  MethodWorkspace<Workspace> workspace_;
 };
 
 }  // namespace bendlab

@@ -46,6 +46,7 @@
 
 #include "bendlab/bending/graph_curvature.hpp"
 #include "bendlab/bending/method_registry.hpp"
+#include "bendlab/bending/variational_assembly.hpp"
 #include "bendlab/core/types.hpp"
 #include "bendlab/mesh/topology.hpp"
 
@@ -133,21 +134,44 @@ std::vector<MongeJetFit> monge_jet_fit(const Topology& topology, const Points& x
 std::vector<MongeJetFit> monge_jet_fit(const Topology& topology, const Points& x, const Points& mwa_normal,
                                        const MongeJetSettings& settings, const MongeJetSupports& supports);
 
+/// Buffers of monge_jet_fit (each thread's supports and neighbourhood, built for one topology),
+/// kept by the method from call to call so that the fits allocate nothing once warm.
+class MongeJetWorkspace {
+ public:
+  MongeJetWorkspace();
+  ~MongeJetWorkspace();
+  MongeJetWorkspace(const MongeJetWorkspace&) = delete;
+  MongeJetWorkspace& operator=(const MongeJetWorkspace&) = delete;
+  struct Thread;
+  /// Thread k's buffers for `topology` (made on first use or when the topology changes); call
+  /// prepare() before the parallel region.
+  Thread& thread(int k, const Topology& topology);
+  /// Room for omp_get_max_threads() threads.
+  void prepare();
+
+ private:
+  std::vector<std::unique_ptr<Thread>> threads_;
+};
+
+/// The same fits into `fits` (resized), with the buffers of `ws`.
+void monge_jet_fit(const Topology& topology, const Points& x, const Points& mwa_normal,
+                   const MongeJetSettings& settings, const MongeJetSupports& supports, MongeJetWorkspace& ws,
+                   std::vector<MongeJetFit>& fits);
+
 /// Method M.
-class MongeJetMethod : public BendingMethod {
+class MongeJetMethod : public VariationalMethod {
  public:
   explicit MongeJetMethod(MongeJetSettings settings = {});
+  ~MongeJetMethod() override;
   static std::unique_ptr<BendingMethod> create(const MethodOptions& options);
   /// The method's entry in the registry (method_registry.hpp): description, options, capabilities.
   static MethodInfo info();
 
   std::string name() const override { return "M"; }
-  BendingResult compute(const Topology& topology, const Points& x, double kappa_b) const override;
 
  protected:
-  /// c0 and ADE through the force law of docs/conventions.md §5 (variational_assembly.hpp).
-  bool supports_membrane_terms() const override { return true; }
-  BendingResult compute_terms(const Topology& topology, const Points& x, const BendingParameters& params) const override;
+  /// n, H, K, lapH from the jets and the mixed area; eq. (10) and c0 / ADE are VariationalMethod's.
+  void fields(const Topology& topology, const Points& x, BendingResult& out) const override;
 
  public:
   const MongeJetSettings& settings() const { return settings_; }
@@ -159,6 +183,9 @@ class MongeJetMethod : public BendingMethod {
   MongeJetSettings settings_;
   mutable std::mutex cache_mutex_;
   mutable std::unordered_map<const Topology*, std::shared_ptr<const MongeJetSupports>> cache_;
+  struct Workspace;
+  /// The geometry, the fits and their buffers of the last call, kept between calls.
+  MethodWorkspace<Workspace> workspace_;
 };
 
 }  // namespace bendlab

@@ -30,13 +30,19 @@ struct MeshGeometry {
   Scalars angle_sum;            ///< N, sum of the corner angles at the vertex
   Points normal_mwa;            ///< N x 3, unit
   Scalars gaussian_curvature;   ///< N, eq. (12)
+  CornerValues corner_voronoi;  ///< F x 3, each corner's share of voronoi_area
+  CornerValues corner_mixed;    ///< F x 3, each corner's share of mixed_area
 
   static MeshGeometry compute(const Topology& topology, const Points& x);
+  /// The same into `out`, reusing its arrays (no allocation when they already have the mesh's sizes).
+  static void compute(const Topology& topology, const Points& x, MeshGeometry& out);
 };
 
 /// Meyer's mixed area alone: MeshGeometry::compute(topology, x).mixed_area, bit for bit (tested),
 /// without the angles, normals and edge weights (for methods that need only the area, e.g. S).
 Scalars mixed_area(const Topology& topology, const Points& x);
+/// The same into `area`, with the per-corner shares in `corner_mixed` (both reused).
+void mixed_area(const Topology& topology, const Points& x, Scalars& area, CornerValues& corner_mixed);
 
 /// Cotangent Laplace-Beltrami of a per-vertex scalar, with the div-grad sign (negative
 /// semidefinite): (Lap w)_i = 1/(2 A_i) sum_j T_ij (w_j - w_i), eq. (11) with A_i = area(i).
@@ -46,10 +52,18 @@ Scalars cotan_laplacian(const Topology& topology, const MeshGeometry& geometry, 
 /// The same operator applied to each column of a per-vertex vector field (e.g. positions).
 Points cotan_laplacian(const Topology& topology, const MeshGeometry& geometry, const Points& w,
                        const Scalars& area);
+/// Both into `out` (resized; no allocation when it has the size already).
+void cotan_laplacian(const Topology& topology, const MeshGeometry& geometry, const Scalars& w, const Scalars& area,
+                     Scalars& out);
+void cotan_laplacian(const Topology& topology, const MeshGeometry& geometry, const Points& w, const Scalars& area,
+                     Points& out);
 
 /// Mean curvature from eq. (2) with the cotangent Laplacian: H_i = -1/2 (Lap x)_i . n_i, positive
 /// on a sphere (Lap x = -2 H n).
 Scalars mean_curvature_cotan(const Topology& topology, const MeshGeometry& geometry, const Points& x,
                              const Points& normals, const Scalars& area);
+/// The same into `H`, with Lap x in `lap_x` (both reused).
+void mean_curvature_cotan(const Topology& topology, const MeshGeometry& geometry, const Points& x,
+                          const Points& normals, const Scalars& area, Points& lap_x, Scalars& H);
 
 }  // namespace bendlab

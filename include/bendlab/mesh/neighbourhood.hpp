@@ -39,7 +39,8 @@ class VertexRings {
   bool stamped_ = false;
   std::size_t last_ring_begin_ = 0;
   std::vector<int> list_;
-  std::vector<int> mark_;  ///< mark_[v] == centre_: v already collected (or is the centre)
+  unsigned stamp_ = 0;          ///< this start's mark (a new one at every start that goes beyond ring 1)
+  std::vector<unsigned> mark_;  ///< mark_[v] == stamp_: v already collected (or is the centre)
 };
 
 /// The vertices at graph distance 1..k from vertex i, in VertexRings order (k = 0: none).

@@ -23,7 +23,7 @@
 //     * a target x_i uses the far rule for cluster c when |x_i - c_c| >= far_ratio * rho_c. By the
 //       Taylor expansion of G about c_c, the far rule then differs from the 7-point rule by
 //       O((rho_c / |x_i - c_c|)^(far_order + 1)) relative to the cluster's (absolute) contribution.
-//   Measured (bench/bench_bim.cpp BM_QuadratureRatio, tests/flow/test_stokes_single_layer.cpp),
+//   Measured (bench/bench_bim.cpp BM_QuadratureRatio, tests/flow/test_single_layer_adaptive.cpp),
 //   as the difference max_i |u_adaptive(x_i) - u_all7(x_i)| / max_i |u_all7(x_i)|, with Method C's
 //   bending force density, one thread: on the 5120-triangle red blood cell and 2:1:0.5 ellipsoid
 //   the defaults (32, 1, 4) give 4e-5 to 1.2e-4 at 1.1 to 1.5 times the speed of all7 (wall clock,
@@ -57,7 +57,7 @@
 //       about A_j (rho_j / d)^(q+1) / d times the Lebesgue constant of the proxies, so the
 //       acceptance keeps each accepted cluster's error below about tau U, at most tree_ratio
 //       (> 1) box radii away, which keeps every node off the far field of its own triangles.
-//   Measured (tests/flow/test_stokes_single_layer.cpp; bench: ./build/release/bench_bim
+//   Measured (tests/flow/test_single_layer_tree.cpp; bench: ./build/release/bench_bim
 //   --benchmark_filter='BM_QuadratureRatio/.*_tree/triangles:(1280|5120)/' --benchmark_min_time=2)
 //   with the defaults (32, 7, 1.5, 2e-6), max_i |u_tree - u_all7| / max_i |u_all7|: 1.2e-6 (red
 //   blood cell) and 2.8e-7 (ellipsoid) at 1280 triangles, 2.2e-6 and 4.4e-7 at 5120. Speed-up over
@@ -92,7 +92,7 @@
 //   16 partial sums in float), and those sums are added in double. The ring triangles' 7-point
 //   terms, which the polar rule replaces, are taken back in double: their single-precision
 //   values differ by that relative error. Measured in the tests (tests/flow/
-//   test_stokes_single_layer.cpp), max_i |u - u_ref| / max_i |u_ref|: 2.4e-7 (red blood cell) and
+//   test_single_layer_mixed.cpp), max_i |u - u_ref| / max_i |u_ref|: 2.4e-7 (red blood cell) and
 //   1.6e-7 (ellipsoid) from the double tree at 1280 triangles, 2.2e-7 from all7 with no far field
 //   (every face by the 7-point rule in single precision); from all7 with the defaults 1.2e-6 /
 //   3.6e-7 at 1280 and 2.2e-6 / 4.6e-7 at 5120 triangles (the tree's own 1.2e-6 / 2.8e-7 and
@@ -126,14 +126,22 @@
 //   (sub-triangles at the singular vertex) of `angular_points` points each.
 // All quadrature points, weights and interpolated densities are precomputed once per evaluation
 // in structure-of-arrays form; the loop over targets runs in parallel (OpenMP).
+// Where the parts are: triangle_quadrature.hpp the 7-point and Gauss-Legendre rules;
+// singular_polar_integral.hpp the triangles at the target; stokeslet_sums.hpp the regular sums
+// (double and single precision); single_layer_adaptive.cpp, single_layer_tree.cpp and
+// single_layer_mixed.cpp each rule's set-up and per-target traversal; stokes_single_layer.cpp the
+// options, the 7-point points of an evaluation and velocity().
 #include <cstdint>
 #include <string>
 #include <vector>
 
 #include "bendlab/core/types.hpp"
+#include "bendlab/flow/bim/triangle_quadrature.hpp"
 #include "bendlab/mesh/topology.hpp"
 
 namespace bendlab {
+
+struct MixedRange;  // stokeslet_sums.hpp
 
 /// all7: the 7-point rule on every non-singular triangle for every target (the reference, default);
 /// adaptive: the 7-point rule near the target, the moment-corrected centroid rule far from it;
@@ -171,9 +179,23 @@ class StokesSingleLayer {
 
  private:
   void prepare(const Points& x, const Points& f) const;
+  /// adaptive (single_layer_adaptive.cpp): the clusters' centres, radii and far weights; a
+  /// target's regular sum (u[0..2]).
+  void prepare_adaptive(const Points& x) const;
+  void adaptive_sum(double xi, double yi, double zi, double* u) const;
+  /// tree (single_layer_tree.cpp): the clusters and the proxies' reference points and Lagrange
+  /// basis (once); the k-d refinement of the sorted faces, the boxes and proxies (per
+  /// evaluation); a target's regular sum.
+  void build_tree();
+  void refine_tree_order(const Points& x) const;
   void prepare_tree(const Points& x) const;
-  /// tree_mixed: the single-precision copies of the leaves' points and the clusters' proxies.
+  void tree_sum(double xi, double yi, double zi, double* u) const;
+  /// tree_mixed (single_layer_mixed.cpp): where the leaves' points and the clusters' proxies go
+  /// in the float arrays (once), their single-precision copies (per evaluation), a target's
+  /// regular sum with `ranges` for its leaves and clusters.
+  void layout_single_precision();
   void prepare_single_precision() const;
+  void mixed_sum(double xi, double yi, double zi, std::vector<MixedRange>& ranges, double* u) const;
   bool tree() const {
     return options_.quadrature == SingleLayerQuadrature::tree || options_.quadrature == SingleLayerQuadrature::tree_mixed;
   }
@@ -212,17 +234,5 @@ class StokesSingleLayer {
   int mixed_proxy_count_ = 0;
   mutable std::vector<float> mx_, my_, mz_, mfx_, mfy_, mfz_;
 };
-
-/// The 7-point degree-5 rule on a triangle: barycentric coordinates (of corners 0, 1, 2) and
-/// weights summing to 1 (multiply by the area).
-struct TriangleRule7 {
-  static constexpr int size = 7;
-  double bary[7][3];
-  double weight[7];
-};
-const TriangleRule7& triangle_rule7();
-
-/// Gauss-Legendre nodes and weights on [0, 1] (n >= 1).
-void gauss_legendre_unit(int n, std::vector<double>& nodes, std::vector<double>& weights);
 
 }  // namespace bendlab

@@ -1,0 +1,78 @@
+"""The section "Order of the methods" of docs/benchmarks.md (scripts/make_benchmarks_doc.py
+--section order): written from the BM_Order rows of a bench_bending report into an existing
+document, in place of the section if it is there, before "Running one benchmark" if not, the
+rest of the document unchanged."""
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+SCRIPT = Path(__file__).resolve().parents[2] / "scripts" / "make_benchmarks_doc.py"
+
+
+def order_report(times):
+    """A bench_bending JSON report with BM_Order rows: times[(q, p)] = (cpu ms, page faults per call)."""
+    rows = []
+    for (q, p), (cpu, faults) in times.items():
+        rows.append({"name": f"BM_Order/{q}/after:{p}/iterations:5/real_time", "run_type": "iteration",
+                     "real_time": cpu * 1.5, "cpu_time": cpu, "time_unit": "ms", "iterations": 5,
+                     "page_faults_per_call": faults, "vertices": 40962})
+    rows.append({"name": "BM_Compute/C/triangles:81920/threads:1/real_time", "run_type": "iteration",
+                 "real_time": 9.0, "cpu_time": 8.0, "time_unit": "ms", "iterations": 50})
+    return {"context": {}, "benchmarks": rows}
+
+
+def run(tmp_path, times, doc):
+    results = tmp_path / "results"
+    results.mkdir(exist_ok=True)
+    (results / "bench_bending.json").write_text(json.dumps(order_report(times)))
+    (results / "machine.txt").write_text("load_start: 0.5 0.6 0.7\nload_end: 0.8 0.9 1.0\n")
+    out = tmp_path / "benchmarks.md"
+    out.write_text(doc)
+    subprocess.run([sys.executable, str(SCRIPT), "--section", "order", "--results", str(results), "--out", str(out)],
+                   check=True)
+    return out.read_text()
+
+
+def test_section_inserted_before_the_last_one_and_the_rest_kept(tmp_path):
+    doc = "# Benchmarks\n\n## Bending\n\ntable\n\n## Running one benchmark\n\n    cmd\n"
+    times = {("A", "A"): (12.0, 0.0), ("A", "C"): (13.0, 0.0), ("C", "A"): (8.0, 0.0), ("C", "C"): (9.0, 2.0)}
+    text = run(tmp_path, times, doc)
+    assert text.startswith("# Benchmarks\n\n## Bending\n\ntable\n\n## Order of the methods (`BM_Order`)")
+    assert text.rstrip().endswith("## Running one benchmark\n\n    cmd")
+    assert "| Q, after P: | A | C | spread | noise | page faults per call (max) |" in text
+    assert "| A | 12 | 13 | 1.08 | - | 0 |" in text
+    assert "| C | 8 | 9 | 1.13 | - | 2 |" in text
+    assert "0.5 0.6 0.7" in text and "0.8 0.9 1.0" in text
+
+
+def test_section_replaced_in_place(tmp_path):
+    doc = ("# Benchmarks\n\n## Order of the methods (`BM_Order`)\n\nold table\n\n"
+           "## Running one benchmark\n\n    cmd\n")
+    text = run(tmp_path, {("C", "C"): (9.0, 0.0)}, doc)
+    assert "old table" not in text
+    assert text.count("## Order of the methods") == 1
+    assert "| C | 9 | 1.00 | - | 0 |" in text
+
+
+def test_repetitions_give_medians_and_noise(tmp_path):
+    # Three repetitions of each pair (rows with the same name): the median in the cell, the
+    # largest coefficient of variation of a pair as the row's noise.
+    results = tmp_path / "results"
+    results.mkdir()
+    rows = []
+    for p, reps in (("A", (10.0, 11.0, 12.0)), ("C", (10.0, 10.0, 10.0))):
+        for cpu in reps:
+            rows.append({"name": f"BM_Order/C/after:{p}/iterations:5/real_time", "run_type": "iteration",
+                         "real_time": cpu, "cpu_time": cpu, "time_unit": "ms", "iterations": 5,
+                         "page_faults_per_call": 0.0})
+        rows.append({"name": f"BM_Order/C/after:{p}/iterations:5/real_time_mean", "run_type": "aggregate",
+                     "aggregate_name": "mean", "real_time": 11.0, "cpu_time": 11.0, "time_unit": "ms"})
+    (results / "bench_bending.json").write_text(json.dumps({"context": {}, "benchmarks": rows}))
+    out = tmp_path / "benchmarks.md"
+    out.write_text("# Benchmarks\n\n## Running one benchmark\n")
+    subprocess.run([sys.executable, str(SCRIPT), "--section", "order", "--results", str(results), "--out", str(out)],
+                   check=True)
+    text = out.read_text()
+    assert "the median of 3 repetitions" in text
+    assert "| C | 11 | 10 | 1.10 | 9% | 0 |" in text
