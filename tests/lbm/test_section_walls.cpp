@@ -159,7 +159,8 @@ TEST(Lattice, HalfwaySectionWallsEqualFlatWalls) {
 // the circular wall between the nodes, so the profile's error falls at second order with the
 // diameter (the acceptance list asks for at least D^-1.8 over D = 10, 20, 40 dx).
 TEST(Lattice, TubePoiseuilleConvergesAtSecondOrder) {
-  for (double tau : {0.8, 1.2}) {
+  // One tau keeps the test short; docs/results/poiseuille.md has tau = 0.8, 1 and 1.5 to D = 80.
+  for (double tau : {1.2}) {
     std::vector<double> errors;
     std::vector<double> mean_errors;
     for (int D : {10, 20, 40}) {
