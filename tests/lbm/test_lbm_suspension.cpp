@@ -60,23 +60,23 @@ bool any_vertex_inside(const LbmSuspension& s, int a, int b) {
 // flow: they must pass without a vertex ever entering the other cell.
 TEST(LbmSuspension, CellsMeetingInShearNeverOverlap) {
   SuspensionOptions o;
-  o.lattice.nx = 40;
+  o.lattice.nx = 32;
   o.lattice.ny = 14;
-  o.lattice.nz = 20;
+  o.lattice.nz = 16;
   o.lattice.tau = 1.0;
   o.lattice.walls = true;
-  o.lattice.wall_velocity = 0.06;
-  o.vessel = Vessel::box(20, 14, 40);
+  o.lattice.wall_velocity = 0.05;
+  o.vessel = Vessel::box(16, 14, 32);
   o.cell_contact = ContactLaw{0.02, 1.5};  // the immersed boundary alone keeps these cells 1.4 dx apart
   LbmSuspension s(o);
   s.lattice().initialise_shear_flow();
   const auto m = rbc(4.0, 0.005);
   // The upper cell starts upstream (u = gamma z e_x); both discs stand nearly edge-on to the flow,
   // their z ranges overlapping by 6 dx, so the cells collide instead of sliding past.
-  s.add_cell(m, moved(m->reference_positions(), Vec3(-4.5, 0, 1.0), 1.4));
-  s.add_cell(m, moved(m->reference_positions(), Vec3(4.5, 0, -1.0), -1.4));
+  s.add_cell(m, moved(m->reference_positions(), Vec3(-3.5, 0, 1.0), 1.4));
+  s.add_cell(m, moved(m->reference_positions(), Vec3(3.5, 0, -1.0), -1.4));
   double most_contact = 0;
-  for (int step = 1; step <= 900; ++step) {
+  for (int step = 1; step <= 600; ++step) {  // in contact from about step 400
     s.step();
     most_contact = std::max(most_contact, s.cell_contact_energy());
     if (step % 25 != 0) continue;
