@@ -57,9 +57,14 @@ bool is_run_output(const std::string& name, const CapsuleSolver& solver) {
 
 bool is_run_file(const std::string& name, const CapsuleSolver& solver) {
   if (is_run_output(name, solver)) return true;
-  // A temporary: "<output>.tmp" and a suffix (AtomicFile's random one, or none).
-  const std::size_t tmp = name.rfind(".tmp");
-  return tmp != std::string::npos && tmp > 0 && is_run_output(name.substr(0, tmp), solver);
+  // A temporary the run itself can have left, and nothing that merely looks like one: AtomicFile's
+  // "<output>.tmp" and mkstemp's six letters or digits, or the parallel fluid checkpoint's
+  // "<side file>.tmp" (parallel/distributed_checkpoint.hpp). "timeseries.csv.tmp-backup" or
+  // "summary.json.tmp" are a user's files, which --resume and --overwrite must not remove.
+  if (const std::optional<std::string> target = atomic_temp_target(name)) return is_run_output(*target, solver);
+  static const std::string bare = ".tmp";
+  return name.size() > bare.size() && name.compare(name.size() - bare.size(), bare.size(), bare) == 0 &&
+         solver.is_side_file(name.substr(0, name.size() - bare.size()));
 }
 
 std::string compare_arguments(const nlohmann::json& here, const nlohmann::json& saved) {

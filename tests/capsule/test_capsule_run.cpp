@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "bendlab/capsule/capsule_run.hpp"
 #include "bendlab/capsule/checkpoint.hpp"
@@ -373,7 +375,7 @@ TEST_F(CapsuleRun, ResumeRemovesTheRunsStaleTemporariesOnly) {
   o.stop_after_steps = 3;
   ASSERT_FALSE(run_capsule(*s, o).finished);
   // What a kill during writes leaves, and a file of someone else's.
-  for (const char* f : {"snapshot_00001.vtp.tmpAb3dEf", "timeseries.csv.tmp4242", "checkpoint.json.tmpZZZZZZ"})
+  for (const char* f : {"snapshot_00001.vtp.tmpAb3dEf", "timeseries.csv.tmp4242zz", "checkpoint.json.tmpZZZZZZ"})
     spit(run / f, "half");
   spit(run / "mine.tmp", "keep");
   auto again = solver();
@@ -384,6 +386,32 @@ TEST_F(CapsuleRun, ResumeRemovesTheRunsStaleTemporariesOnly) {
     EXPECT_TRUE(e.path().filename() == "mine.tmp" || e.path().filename().string().find(".tmp") == std::string::npos)
         << e.path();
   EXPECT_EQ(slurp(run / "mine.tmp"), "keep");
+}
+
+TEST_F(CapsuleRun, ResumeAndOverwriteKeepFilesThatOnlyLookLikeTemporaries) {
+  // Only "<output>.tmp" and mkstemp's six letters or digits can be a temporary of the run; any
+  // other name after ".tmp" is a file of the user's, and survives --resume and --overwrite.
+  const fs::path run = dir / "run";
+  auto s = solver();
+  CapsuleRunOptions o = options(run, 0.1);
+  o.stop_after_steps = 2;
+  ASSERT_FALSE(run_capsule(*s, o).finished);
+  const std::vector<std::string> users = {"timeseries.csv.tmp-backup-2024", "summary.json.tmp.mine",
+                                          "checkpoint.json.tmp", "D_theta.png.tmp_by_user.png",
+                                          "timing.json.tmp12345", "shapes.pvd.tmpABCDEFG"};
+  for (const std::string& f : users) spit(run / f, "user's " + f);
+  spit(run / "timeseries.csv.tmpQ9x2Lm", "half");  // a temporary of a killed write
+  auto again = solver();
+  o.stop_after_steps = 0;
+  o.resume = true;
+  ASSERT_TRUE(run_capsule(*again, o).finished);
+  EXPECT_FALSE(fs::exists(run / "timeseries.csv.tmpQ9x2Lm"));
+  for (const std::string& f : users) EXPECT_EQ(slurp(run / f), "user's " + f) << f << " after --resume";
+  auto third = solver();
+  o.resume = false;
+  o.overwrite = true;
+  ASSERT_TRUE(run_capsule(*third, o).finished);
+  for (const std::string& f : users) EXPECT_EQ(slurp(run / f), "user's " + f) << f << " after --overwrite";
 }
 
 TEST_F(CapsuleRun, AFolderWhoseParentIsMissingIsRefused) {
