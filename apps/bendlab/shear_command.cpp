@@ -220,7 +220,7 @@ const CommandRegistration registration([](CLI::App& app) {
       ->capture_default_str();
   auto* resume = cmd->add_flag("--resume", args->resume,
                                "continue the run in --out from its last checkpoint (--t-end must be later than the "
-                               "checkpoint's time)");
+                               "checkpoint's time; equal to it, a run stopped before its summary is completed)");
   cmd->add_flag("--overwrite", args->overwrite,
                 "start a new run in an --out that holds another run, removing that run's files (timeseries.csv, "
                 "snapshots, checkpoint, summary, plot); without it such a folder is refused")

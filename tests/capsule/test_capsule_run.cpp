@@ -414,6 +414,36 @@ TEST_F(CapsuleRun, ResumeAndOverwriteKeepFilesThatOnlyLookLikeTemporaries) {
   for (const std::string& f : users) EXPECT_EQ(slurp(run / f), "user's " + f) << f << " after --overwrite";
 }
 
+TEST_F(CapsuleRun, AResumeToTheCheckpointsOwnEndWritesTheMissingSummary) {
+  // A run stopped between its final checkpoint and summary.json (a kill, a failed summary write)
+  // is completed by a resume with the same t_end: the summary the whole run would have written.
+  const fs::path run = dir / "run";
+  auto s = solver();
+  const CapsuleRunResult whole = run_capsule(*s, options(run, 0.05));
+  ASSERT_TRUE(whole.finished);
+  const std::string series = slurp(run / "timeseries.csv");
+  fs::remove(run / "summary.json");
+  fs::remove(run / "timing.json");
+  auto again = solver();
+  CapsuleRunOptions o = options(run, 0.05);
+  o.resume = true;
+  const CapsuleRunResult completed = run_capsule(*again, o);
+  ASSERT_TRUE(completed.finished);
+  EXPECT_EQ(completed.summary, whole.summary);
+  EXPECT_EQ(nlohmann::json::parse(slurp(run / "summary.json")), whole.summary);
+  EXPECT_TRUE(fs::exists(run / "timing.json"));
+  EXPECT_EQ(slurp(run / "timeseries.csv"), series);  // no step taken, no row added
+  // An end before the checkpoint's is still refused.
+  auto earlier = solver();
+  o.t_end = 0.04;
+  try {
+    run_capsule(*earlier, o);
+    ADD_FAILURE() << "resumed to an earlier end";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("is before the checkpoint"), std::string::npos) << e.what();
+  }
+}
+
 TEST_F(CapsuleRun, AFolderWhoseParentIsMissingIsRefused) {
   auto s = solver();
   try {
@@ -467,15 +497,16 @@ TEST_F(CapsuleRun, ManyRunsInOneProcess) {
   }
 }
 
-TEST_F(CapsuleRun, ResumeToAnEarlierOrEqualEndIsRefusedBeforeAnyChange) {
-  // Resuming a run that reached gamma t = 0.15 with t_end <= 0.15 would write a summary of a run
-  // that did not end at t_end: refused, and the folder stays as it was.
+TEST_F(CapsuleRun, ResumeToAnEarlierEndIsRefusedBeforeAnyChange) {
+  // Resuming a run that reached gamma t = 0.15 with t_end < 0.15 would write a summary of a run
+  // that did not end at t_end: refused, and the folder stays as it was. (t_end = 0.15 completes
+  // the run's files: AResumeToTheCheckpointsOwnEndWritesTheMissingSummary.)
   auto s = solver();
   const fs::path run = dir / "run";
   ASSERT_TRUE(run_capsule(*s, options(run, 0.15)).finished);
   const std::string series = slurp(run / "timeseries.csv"), checkpoint = slurp(run / "checkpoint.json"),
                     summary = slurp(run / "summary.json");
-  for (double t_end : {0.15, 0.1}) {
+  for (double t_end : {0.15 - 1e-9, 0.1}) {
     CapsuleRunOptions o = options(run, t_end);
     o.resume = true;
     auto fresh = solver();
@@ -483,7 +514,7 @@ TEST_F(CapsuleRun, ResumeToAnEarlierOrEqualEndIsRefusedBeforeAnyChange) {
       run_capsule(*fresh, o);
       ADD_FAILURE() << "resumed to t_end = " << t_end;
     } catch (const Error& e) {
-      EXPECT_NE(std::string(e.what()).find("is not after the checkpoint's gamma t"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("is before the checkpoint's gamma t"), std::string::npos) << e.what();
     }
     EXPECT_EQ(slurp(run / "timeseries.csv"), series);
     EXPECT_EQ(slurp(run / "checkpoint.json"), checkpoint);

@@ -611,19 +611,25 @@ TEST_F(Cli, ShearRefusesLooseTolerancesAndWarnsAboutLooseOnes) {
   EXPECT_NE(r.err.find("warning: --rtol 0.001 is above 0.0001"), std::string::npos) << r.err;
 }
 
-TEST_F(Cli, ShearResumeToAnEarlierOrEqualEndIsRefused) {
+TEST_F(Cli, ShearResumeToAnEarlierEndIsRefusedAndToItsOwnEndCompletesTheRun) {
   const fs::path out = dir / "run";
   const std::string common = "shear --mesh mt1:320 --snapshot-every 0.01 --no-plot --out " + out.string();
   ASSERT_EQ(run(common + " --t-end 0.02").status, 0);
   const std::string summary = slurp(out / "summary.json"), series = slurp(out / "timeseries.csv");
-  for (const char* t_end : {"0.02", "0.01"}) {
+  for (const char* t_end : {"0.0199", "0.01"}) {
     const CliRun r = run(common + " --resume --t-end " + t_end);
     EXPECT_NE(r.status, 0);
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
-    EXPECT_NE(r.err.find("is not after the checkpoint's gamma t"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("is before the checkpoint's gamma t"), std::string::npos) << r.err;
     EXPECT_EQ(slurp(out / "summary.json"), summary);
     EXPECT_EQ(slurp(out / "timeseries.csv"), series);
   }
+  // Stopped between the final checkpoint and summary.json: a resume to the same end writes it.
+  fs::remove(out / "summary.json");
+  const CliRun r = run(common + " --resume --t-end 0.02");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(slurp(out / "summary.json"), summary);
+  EXPECT_EQ(slurp(out / "timeseries.csv"), series);
 }
 
 TEST_F(Cli, ShearSkalakLawIsRecordedAndPartOfTheRunsIdentity) {
