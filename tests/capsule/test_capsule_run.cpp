@@ -105,6 +105,36 @@ TEST(SteadyStatistics, WindowAndWeightedMeans) {
   }
 }
 
+TEST(TimeSeries, WhateverTheWriterWritesTheReaderReads) {
+  // The extremes a run can produce: subnormals (energies of kS = 1/G at G = 1e308 came out as
+  // 1.23301775164e-314), the largest and smallest normal numbers (the largest to 15 digits,
+  // 1.79769313486232e+308, would be past it), infinities, signed zeros. Each row reads back to a
+  // row that is written as the very same text.
+  using L = std::numeric_limits<double>;
+  for (const double v : {L::denorm_min(), 1.23301775164e-314, -2.5e-320, L::min(), -L::min(), L::max(), -L::max(),
+                         L::infinity(), -L::infinity(), 0.0, -0.0, 1e-300}) {
+    const TimeSeriesRow row{0.5, v, v, v, v, v, v, 0.01, v, v};
+    const std::string line = format_time_series_row(row);
+    std::vector<TimeSeriesRow> back;
+    ASSERT_NO_THROW(back = parse_time_series(std::string(time_series_header()) + "\n" + line, "t.csv")) << line;
+    ASSERT_EQ(back.size(), 1u);
+    EXPECT_EQ(format_time_series_row(back[0]), line);
+    if (v != 0 && std::isfinite(v)) {
+      EXPECT_NE(back[0].D, 0.0) << line;
+    }
+  }
+  // Numbers beyond the doubles are still refused, naming the line.
+  for (const char* cell : {"1e400", "-1e999"}) {
+    const std::string text = std::string(time_series_header()) + "\n0.5," + cell + ",0,0,0,0,0,0.01,0,0\n";
+    try {
+      parse_time_series(text, "t.csv");
+      ADD_FAILURE() << cell;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("line 2"), std::string::npos) << e.what();
+    }
+  }
+}
+
 TEST_F(CapsuleRun, TimeSeriesResumeKeepsRowsByteForByte) {
   const fs::path p = dir / "timeseries.csv";
   {
