@@ -257,10 +257,11 @@ CapsuleRunResult run_shear(const ShearRunSpec& a, const ShearRunCallbacks& callb
   // or reference is part of it.
   if (!a.shape.is_default()) {
     o.arguments["shape"] = a.shape.shape;
-    o.arguments["aspect"] = a.shape.aspect;
+    // An aspect not given is recorded as 0, as it always was (0 itself is refused).
+    o.arguments["aspect"] = a.shape.aspect.value_or(0.0);
     o.arguments["tilt"] = a.shape.tilt_degrees;
     o.arguments["reference_shape"] = a.shape.reference;
-    o.arguments["reference_aspect"] = a.shape.reference_aspect;
+    o.arguments["reference_aspect"] = a.shape.reference_aspect.value_or(0.0);
   }
   for (const auto& [key, value] : lattice_arguments.items()) o.arguments[key] = value;
   summary_fields["membrane_law"] = a.membrane;
