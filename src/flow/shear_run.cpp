@@ -179,6 +179,13 @@ CapsuleRunResult run_shear(const ShearRunSpec& a, const ShearRunCallbacks& callb
     in.kV_over_kS = kEspressoVolumeRatio;
     in.gamma_t_end = a.t_end;
     in.kernel = l.kernel == "phi2" ? lbm::IbKernel::Phi2 : l.kernel == "phi3" ? lbm::IbKernel::Phi3 : lbm::IbKernel::Phi4;
+    // The box must hold the shape as it starts, not only the sphere: a tilted prolate spheroid is
+    // longer along x than 2 R. The sphere keeps its radius 1, as always.
+    if (a.shape.shape != "sphere") {
+      const Vec3 centre = volume_centroid(mesh.topology(), geometry.initial);
+      for (int k = 0; k < 3; ++k)
+        in.half_extent[static_cast<std::size_t>(k)] = (geometry.initial.col(k).array() - centre[k]).abs().maxCoeff();
+    }
     const lbm::CapsuleRunParameters p = lbm::capsule_run_parameters(in);
     if (callbacks.on_note)
       for (const std::string& w : p.warnings) callbacks.on_note("warning: " + w);

@@ -804,3 +804,18 @@ TEST_F(Cli, ShearShapeOptionsAreCheckedAndPartOfTheRunsIdentity) {
   EXPECT_EQ(l.at("reference_shape"), "oblate");
   EXPECT_NEAR(l.at("initial_volume").get<double>(), l.at("capsule_shape").at("mesh_volume").get<double>(), 1e-12);
 }
+
+// What a hostile-input probe found: shapes, numbers and messages.
+
+TEST_F(Cli, ShearRefusesAZeroAspectAndABoxShorterThanTheShape) {
+  const fs::path out = dir / "run";
+  expect_refused(run("shear --shape oblate --aspect 0 --mesh mt1:320 --out " + out.string()), "--aspect 0", out);
+  expect_refused(run("shear --shape rbc --reference-shape oblate --reference-aspect 0 --mesh mt1:320 --out " +
+                     out.string()),
+                 "--reference-aspect 0", out);
+  // A prolate spheroid of c/a = 4 lying along x is 15 nodes long at R = 3: a 9-node period would
+  // hold it overlapping its own image.
+  expect_refused(run("shear --solver lbm --shape prolate --aspect 4 --tilt 90 --mesh mt1:320 --radius-lu 3 "
+                     "--box 3,3,4 --out " + out.string()),
+                 "box x of 9 nodes does not contain the capsule", out);
+}
