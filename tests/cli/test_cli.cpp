@@ -819,3 +819,18 @@ TEST_F(Cli, ShearRefusesAZeroAspectAndABoxShorterThanTheShape) {
                      "--box 3,3,4 --out " + out.string()),
                  "box x of 9 nodes does not contain the capsule", out);
 }
+
+TEST_F(Cli, SeedsAreWholeNumbersWithinTheirRange) {
+  const fs::path out = dir / "m.off", study = dir / "study";
+  for (const char* seed : {"-1", "18446744073709551616", "1e23", "1.5", "", "0x10"}) {
+    expect_refused(run({"mesh", "--family", "irregular", "--level", "1", "--jitter-seed", seed, "--out", out.string()}),
+                   "--jitter-seed", out);
+    expect_refused(run({"rbc", "--families", "irregular", "--max-triangles", "320", "--methods", "C",
+                        "--jitter-seed", seed, "--no-plots", "--out", study.string()}),
+                   "--jitter-seed", study);
+  }
+  const CliRun r = run("mesh --family irregular --level 1 --jitter-seed 18446744073709551614 --out " + out.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  // Level 1 uses the base seed + 1: the largest seed there is.
+  EXPECT_EQ(nlohmann::json::parse(r.out).at("jitter_seed").get<std::uint64_t>(), 18446744073709551615ull);
+}
