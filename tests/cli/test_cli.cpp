@@ -834,3 +834,10 @@ TEST_F(Cli, SeedsAreWholeNumbersWithinTheirRange) {
   // Level 1 uses the base seed + 1: the largest seed there is.
   EXPECT_EQ(nlohmann::json::parse(r.out).at("jitter_seed").get<std::uint64_t>(), 18446744073709551615ull);
 }
+
+TEST_F(Cli, ShearNamesAnOverflowingAdeTermBeforeWork) {
+  const fs::path out = dir / "run";
+  expect_refused(run("shear --method C --mesh mt1:320 --kappa-b-hat 0.05 --ade-alpha 1 --ade-d 1e-300 --ade-da0 0.1 "
+                     "--t-end 0.05 --no-plot --out " + out.string()),
+                 "ADE term", out);
+}
