@@ -841,3 +841,12 @@ TEST_F(Cli, ShearNamesAnOverflowingAdeTermBeforeWork) {
                      "--t-end 0.05 --no-plot --out " + out.string()),
                  "ADE term", out);
 }
+
+TEST_F(Cli, RbcRefusesAnOverflowingForceLawBeforeWork) {
+  // The exact force density of c0 = 1e308 overflows: refused before the study starts, naming the
+  // option, and without the output folder.
+  const fs::path study = dir / "study";
+  expect_refused(run("rbc --families mt1 --max-triangles 320 --methods C --c0 1e308 --no-plots --out " +
+                     study.string()),
+                 "--c0", study);
+}
