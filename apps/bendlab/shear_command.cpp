@@ -52,8 +52,12 @@ void plot(const ShearArgs& a) {
                                              a.plot_script));
     return;
   }
-  if (run_helper_program({"/usr/bin/python3", script.string(), a.out}) != 0)
-    note("warning: the plot was not made (needs /usr/bin/python3 with matplotlib)");
+  try {
+    if (run_helper_program({"/usr/bin/python3", script.string(), a.out}) != 0)
+      note("warning: the plot was not made (needs /usr/bin/python3 with matplotlib)");
+  } catch (const Error& e) {  // the interpreter cannot start: still only a plot not made
+    note(fmt::format("warning: the plot was not made ({})", e.what()));
+  }
 }
 
 void shear(const ShearArgs& a) {

@@ -850,3 +850,14 @@ TEST_F(Cli, RbcRefusesAnOverflowingForceLawBeforeWork) {
                      study.string()),
                  "--c0", study);
 }
+
+TEST_F(Cli, RbcWithAPythonThatCannotStartWarnsAndSucceeds) {
+  // The data files are the results; a plot not made is a warning, whatever the reason.
+  const fs::path study = dir / "study";
+  const CliRun r = run({"rbc", "--families", "mt1", "--max-triangles", "320", "--methods", "C", "--python",
+                        "/nonexistent/python3", "--out", study.string()});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("warning: the plots were not made"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("/nonexistent/python3"), std::string::npos) << r.err;
+  EXPECT_TRUE(fs::is_regular_file(study / "errors.csv"));
+}
