@@ -822,13 +822,13 @@ TEST_F(Cli, ShearRefusesAZeroAspectAndABoxShorterThanTheShape) {
 
 TEST_F(Cli, SeedsAreWholeNumbersWithinTheirRange) {
   const fs::path out = dir / "m.off", study = dir / "study";
-  for (const char* seed : {"-1", "18446744073709551616", "1e23", "1.5", "", "0x10"}) {
+  // CLI11 took each of these for 2^64 - 1. (Every unsigned option has the same check: rbc's once.)
+  for (const char* seed : {"-1", "18446744073709551616", "1e23", "1.5"})
     expect_refused(run({"mesh", "--family", "irregular", "--level", "1", "--jitter-seed", seed, "--out", out.string()}),
                    "--jitter-seed", out);
-    expect_refused(run({"rbc", "--families", "irregular", "--max-triangles", "320", "--methods", "C",
-                        "--jitter-seed", seed, "--no-plots", "--out", study.string()}),
-                   "--jitter-seed", study);
-  }
+  expect_refused(run({"rbc", "--families", "irregular", "--max-triangles", "320", "--methods", "C", "--jitter-seed",
+                      "-1", "--no-plots", "--out", study.string()}),
+                 "--jitter-seed", study);
   const CliRun r = run("mesh --family irregular --level 1 --jitter-seed 18446744073709551614 --out " + out.string());
   ASSERT_EQ(r.status, 0) << r.err;
   // Level 1 uses the base seed + 1: the largest seed there is.
