@@ -5,11 +5,14 @@
 // message (naming the rank) and ends every rank with MPI_Abort (docs/mpi.md).
 #include <fmt/format.h>
 
+#include <charconv>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <cstdint>
 #include <iostream>
+#include <limits>
 #include <set>
 #include <string>
 #include <thread>
@@ -54,16 +57,33 @@ bool launched_by_mpi() {
 }
 #endif
 
+// An unsigned option (a seed) is decimal digits within 0 ... 2^64 - 1. CLI11 alone takes "-1",
+// "1e23" and "18446744073709551616" all for 2^64 - 1.
+std::string whole_number_error(const std::string& value) {
+  std::uint64_t v = 0;
+  const char* end = value.data() + value.size();
+  const auto [stop, ec] = std::from_chars(value.data(), end, v);
+  if (ec == std::errc::invalid_argument || stop != end)
+    return fmt::format("'{}' is not a whole number from 0 to {}", value, std::numeric_limits<std::uint64_t>::max());
+  if (ec == std::errc::result_out_of_range)
+    return fmt::format("{} is above the largest value, {}", value, std::numeric_limits<std::uint64_t>::max());
+  return {};
+}
+
 // CLI11 converts an empty value of a numeric option ("--level ''") to 0: every number option of
-// every subcommand refuses one instead, before the conversion.
+// every subcommand refuses one instead, before the conversion; an unsigned one takes a whole
+// number in range only.
 void refuse_empty_numbers(CLI::App& app) {
   static const std::set<std::string> numeric = {"INT", "UINT", "FLOAT", "NUMBER"};
   for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) {
-    for (CLI::Option* opt : sub->get_options([](CLI::Option*) { return true; }))
+    for (CLI::Option* opt : sub->get_options([](CLI::Option*) { return true; })) {
       if (numeric.count(opt->get_type_name()) > 0)
         opt->check(CLI::Validator(
             [](std::string& value) { return value.empty() ? std::string("'' is not a number") : std::string(); },
             "", "not empty"));
+      if (opt->get_type_name() == "UINT")
+        opt->check(CLI::Validator([](std::string& value) { return whole_number_error(value); }, "", "whole number"));
+    }
     refuse_empty_numbers(*sub);
   }
 }

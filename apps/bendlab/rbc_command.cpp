@@ -100,11 +100,18 @@ void run_rbc(const RbcArgs& a) {
   if (a.plots) {
     const std::vector<std::string> argv = {a.python, script.string(), out.string()};
     note(fmt::format("rbc: {}", fmt::join(argv, " ")));
-    // A plot not made is a warning (README, "Errors"): the data files are the results.
-    const int status = run_helper_program(argv);
-    if (status != 0)
-      note(fmt::format("warning: the plots were not made ({} exited with status {}); the data files in {} are complete",
-                       a.python, status, out.string()));
+    // A plot not made is a warning (README, "Errors"), whether the interpreter ran and failed or
+    // could not start at all: the data files are the results.
+    try {
+      const int status = run_helper_program(argv);
+      if (status != 0)
+        note(fmt::format("warning: the plots were not made ({} exited with status {}); the data files in {} are "
+                         "complete",
+                         a.python, status, out.string()));
+    } catch (const Error& e) {
+      note(fmt::format("warning: the plots were not made ({}); the data files in {} are complete", e.what(),
+                       out.string()));
+    }
   }
 }
 

@@ -52,8 +52,12 @@ void plot(const ShearArgs& a) {
                                              a.plot_script));
     return;
   }
-  if (run_helper_program({"/usr/bin/python3", script.string(), a.out}) != 0)
-    note("warning: the plot was not made (needs /usr/bin/python3 with matplotlib)");
+  try {
+    if (run_helper_program({"/usr/bin/python3", script.string(), a.out}) != 0)
+      note("warning: the plot was not made (needs /usr/bin/python3 with matplotlib)");
+  } catch (const Error& e) {  // the interpreter cannot start: still only a plot not made
+    note(fmt::format("warning: the plot was not made ({})", e.what()));
+  }
 }
 
 void shear(const ShearArgs& a) {
@@ -220,7 +224,7 @@ const CommandRegistration registration([](CLI::App& app) {
       ->capture_default_str();
   auto* resume = cmd->add_flag("--resume", args->resume,
                                "continue the run in --out from its last checkpoint (--t-end must be later than the "
-                               "checkpoint's time)");
+                               "checkpoint's time; equal to it, a run stopped before its summary is completed)");
   cmd->add_flag("--overwrite", args->overwrite,
                 "start a new run in an --out that holds another run, removing that run's files (timeseries.csv, "
                 "snapshots, checkpoint, summary, plot); without it such a folder is refused")

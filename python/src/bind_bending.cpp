@@ -48,7 +48,15 @@ BendingParameters terms_from(py::dict& kwargs) {
   BendingParameters p;
   auto take_real = [&](const char* key, double& v) {
     if (!kwargs.contains(key)) return;
-    v = kwargs[key].cast<double>();
+    const py::object value = kwargs[key];
+    // pybind11's own message ("Unable to cast Python instance to C++ type") names no argument.
+    try {
+      v = value.cast<double>();
+    } catch (const py::cast_error&) {
+      throw py::type_error(std::string("Method: ") + key + " must be a real number, got " +
+                           py::repr(value).cast<std::string>() + " (" +
+                           py::str(py::type::handle_of(value).attr("__name__")).cast<std::string>() + ")");
+    }
     PyDict_DelItemString(kwargs.ptr(), key);
   };
   take_real("c0", p.c0);

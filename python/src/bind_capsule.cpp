@@ -34,8 +34,8 @@ void bind_capsule(py::module_& m) {
          double rtol, double atol, bool resume, std::int64_t stop_after_steps, const py::object& progress,
          double progress_interval, const py::dict& method_options, const std::string& integrator,
          const std::string& membrane, double skalak_c, const std::string& bim_quadrature,
-         bool overwrite, const std::string& shape, double aspect, double tilt, const std::string& reference_shape,
-         double reference_aspect) -> py::object {
+         bool overwrite, const std::string& shape, std::optional<double> aspect, double tilt,
+         const std::string& reference_shape, std::optional<double> reference_aspect) -> py::object {
         ShearRunSpec spec;
         spec.folder = folder;
         spec.method = method;
@@ -101,9 +101,9 @@ void bind_capsule(py::module_& m) {
       py::arg("method_options") = py::dict(), py::arg("integrator") = "cash-karp",
       py::arg("membrane") = "neo-hookean", py::arg("skalak_c") = 1.0,
       py::arg("bim_quadrature") = "all7", py::arg("overwrite") = false, py::arg("shape") = "sphere",
-      py::arg("aspect") = 0.0, py::arg("tilt") = 0.0, py::arg("reference_shape") = "initial",
-      py::arg("reference_aspect") = 0.0,
-      "Runs a capsule (initially the sphere, or `shape` 'rbc', 'oblate', 'prolate' of c/a `aspect`, its axis of "
+      py::arg("aspect") = py::none(), py::arg("tilt") = 0.0, py::arg("reference_shape") = "initial",
+      py::arg("reference_aspect") = py::none(),
+      "Runs a capsule (initially the sphere, or `shape` 'rbc', 'oblate', 'prolate' of c/a `aspect` (None: 0.5, 2), its axis of "
       "symmetry tilted by `tilt` degrees from e_z towards e_x, stress-free in `reference_shape` ('initial' or a "
       "shape, of c/a `reference_aspect`), as `bendlab shear --shape` does; membrane law `membrane`: 'neo-hookean', eqs. 18-21, or 'skalak' "
       "with C = skalak_c; plus the bending method) in "

@@ -157,6 +157,13 @@ def test_membrane_parameters_equal_the_cli(name, rbc_1280, cli, tmp_path):
     np.testing.assert_array_equal(bendlab.Method(name, c0=0.0).forces(mesh), bendlab.Method(name).forces(mesh))
 
 
+@pytest.mark.parametrize("key", ["c0", "ade_alpha", "ade_d", "ade_da0", "ade_area"])
+@pytest.mark.parametrize("value", [None, "1", 1j, [1.0]])
+def test_a_membrane_parameter_that_is_no_real_number_is_named(key, value):
+    with pytest.raises(TypeError, match=rf"Method: {key} must be a real number, got .* \({type(value).__name__}\)$"):
+        bendlab.Method("C", **{key: value})
+
+
 def test_membrane_parameters_are_refused_where_invalid():
     with pytest.raises(ValueError, match="method A"):
         bendlab.Method("A", c0=1.0)

@@ -115,6 +115,23 @@ void validate(const RbcStudyOptions& o) {
     if (!p.plain())
       for (const std::string& m : o.methods) make_bending_method(m, options_for(o, m))->check_parameters(p);
   }
+  if (o.c0 != 0 || o.ade_alpha != 0) {
+    // The exact force density normalises every error: it must be a number (c0 = 1e308 overflows
+    // it), or the study would fail after its work began.
+    const BendingParameters p = rbc_bending_parameters(o);
+    p.validate();  // now with the exact area
+    const auto rbc = make_rbc(o.radius);
+    const auto& rev = dynamic_cast<const SurfaceOfRevolution&>(*rbc);
+    const double c0_only = rev.max_force_density(p.c0, p.kappa_b, 0.0);
+    if (!std::isfinite(c0_only))
+      throw Error(fmt::format("--c0 {}: the exact force density of the RBC overflows (max |f| = {})", o.c0, c0_only));
+    const double lambda = p.ade_lambda(rev.integrals().mean_curvature);
+    const double with_ade = rev.max_force_density(p.c0, p.kappa_b, lambda);
+    if (!std::isfinite(with_ade))
+      throw Error(fmt::format("--ade-alpha {}, --ade-d {}, --ade-da0 {}: the exact force density of the RBC overflows "
+                              "(ADE lambda = {}, max |f| = {})",
+                              o.ade_alpha, o.ade_d, o.ade_da0, lambda, with_ade));
+  }
   if (!(o.jitter >= 0) || !std::isfinite(o.jitter))
     throw Error(fmt::format("--jitter: the fraction must be finite and >= 0, got {}", o.jitter));
   // A fold is found only by making the mesh; the irregular meshes are cheap beside the study.

@@ -30,6 +30,14 @@ void BendingParameters::validate() const {
   if (!std::isfinite(ade_area) || ade_area <= 0)
     throw Error(fmt::format("ADE area A must be positive and finite, got {} (give the membrane area)", ade_area));
   if (!std::isfinite(ade_da0)) throw Error(fmt::format("ADE dA0 must be finite, got {}", ade_da0));
+  // Each number may be finite while the term is not: its coefficient alpha pi kB / A, or the term
+  // at M = 0, where M0 = dA0 / (2 d) dominates it (d = 1e-300 with dA0 = 0.1). Such a term would
+  // turn the forces into overflows that surface far from here (as a volume that is no number).
+  const double coefficient = ade_alpha * M_PI * kappa_b / ade_area;
+  if (!std::isfinite(coefficient) || !std::isfinite(ade_energy(0.0)) || !std::isfinite(ade_lambda(0.0)))
+    throw Error(fmt::format("the ADE term alpha pi kB (M - M0)^2 / (2 A) overflows: alpha = {}, kB = {}, A = {}, "
+                            "M0 = dA0 / (2 d) = {} (dA0 = {}, d = {})",
+                            ade_alpha, kappa_b, ade_area, ade_m0(), ade_da0, ade_d));
 }
 
 std::string BendingParameters::describe() const {

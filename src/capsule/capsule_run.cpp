@@ -57,9 +57,14 @@ bool is_run_output(const std::string& name, const CapsuleSolver& solver) {
 
 bool is_run_file(const std::string& name, const CapsuleSolver& solver) {
   if (is_run_output(name, solver)) return true;
-  // A temporary: "<output>.tmp" and a suffix (AtomicFile's random one, or none).
-  const std::size_t tmp = name.rfind(".tmp");
-  return tmp != std::string::npos && tmp > 0 && is_run_output(name.substr(0, tmp), solver);
+  // A temporary the run itself can have left, and nothing that merely looks like one: AtomicFile's
+  // "<output>.tmp" and mkstemp's six letters or digits, or the parallel fluid checkpoint's
+  // "<side file>.tmp" (parallel/distributed_checkpoint.hpp). "timeseries.csv.tmp-backup" or
+  // "summary.json.tmp" are a user's files, which --resume and --overwrite must not remove.
+  if (const std::optional<std::string> target = atomic_temp_target(name)) return is_run_output(*target, solver);
+  static const std::string bare = ".tmp";
+  return name.size() > bare.size() && name.compare(name.size() - bare.size(), bare.size(), bare) == 0 &&
+         solver.is_side_file(name.substr(0, name.size() - bare.size()));
 }
 
 std::string compare_arguments(const nlohmann::json& here, const nlohmann::json& saved) {
@@ -78,6 +83,10 @@ std::string compare_arguments(const nlohmann::json& here, const nlohmann::json& 
 }
 
 namespace {
+
+// Two times closer than this (relative, at least 1) are the same: a resume to the checkpoint's
+// time completes the run instead of continuing it.
+constexpr double kSameTime = 1e-12;
 
 void check_options(const CapsuleRunOptions& o) {
   if (o.folder.empty()) throw Error("capsule run: no output folder");
@@ -217,6 +226,8 @@ CapsuleRunResult run_capsule(CapsuleSolver& solver, const CapsuleRunOptions& o) 
   const MotionMarkers markers = motion_markers(membrane.topology(), membrane.initial_positions());
   MotionAngles unwrapped = motion_angles(capsule_shape(membrane.topology(), membrane.initial_positions()),
                                          membrane.initial_positions(), markers);
+  // Resumed at its end already (t_end is the checkpoint's time): only the summary is missing.
+  bool completing = false;
   if (o.resume) {
     if (!fs::exists(checkpoint_path))
       throw Error(fmt::format("resume: no checkpoint in '{}' to resume from", folder.string()));
@@ -235,9 +246,13 @@ CapsuleRunResult run_capsule(CapsuleSolver& solver, const CapsuleRunOptions& o) 
       unwrapped = {kept.back().axis_angle, kept.back().node_phase};
     if (const std::string diff = compare_arguments(o.arguments, saved.arguments); !diff.empty())
       throw Error(fmt::format("resume: the arguments differ from the run in '{}': {}", folder.string(), diff));
-    if (!(o.t_end > saved.time))
-      throw Error(fmt::format("resume: t_end (--t-end) {} is not after the checkpoint's gamma t = {} in '{}'; a run "
-                              "continues to a later end only (start a new run in another folder instead)",
+    // A run stopped between its final checkpoint and summary.json (killed, or its summary write
+    // failed) resumes to the checkpoint's own time: it takes no step and writes its summary.
+    completing = std::abs(o.t_end - saved.time) <= kSameTime * std::max(1.0, std::abs(saved.time));
+    if (!completing && !(o.t_end > saved.time))
+      throw Error(fmt::format("resume: t_end (--t-end) {} is before the checkpoint's gamma t = {} in '{}'; a run "
+                              "continues to a later end, or to the checkpoint's own to complete its files (start a "
+                              "new run in another folder instead)",
                               o.t_end, saved.time, folder.string()));
     if (saved.solver != solver.name())
       throw Error(fmt::format("{}: \"solver\" is \"{}\", this run uses \"{}\"", checkpoint_path.string(), saved.solver,
@@ -261,7 +276,9 @@ CapsuleRunResult run_capsule(CapsuleSolver& solver, const CapsuleRunOptions& o) 
     }
     saved.arguments = o.arguments;
     state = std::move(saved);
-    note(fmt::format("resuming at gamma t = {:.4g} from {}", solver.time(), checkpoint_path.string()));
+    note(completing ? fmt::format("the run in '{}' reached t_end = {:g} at its last checkpoint: writing its summary",
+                                  folder.string(), o.t_end)
+                    : fmt::format("resuming at gamma t = {:.4g} from {}", solver.time(), checkpoint_path.string()));
   }
 
   const auto start = std::chrono::steady_clock::now();
@@ -318,7 +335,7 @@ CapsuleRunResult run_capsule(CapsuleSolver& solver, const CapsuleRunOptions& o) 
   // an Error that says where; the last checkpoint stays whole and resumable, and timeseries.csv
   // keeps the rows of the accepted steps (a resume truncates them to the checkpoint's).
   try {
-    solver.advance(o.t_end, [&](const AcceptedStep& s) {
+    if (!completing) solver.advance(o.t_end, [&](const AcceptedStep& s) {
       // Before the step is counted: a step over the budget leaves no row and no checkpoint.
       if (o.max_steps > 0 && state.steps >= o.max_steps)
         throw Error(fmt::format("more than {} accepted steps (the budget of --max-steps) to reach gamma t = {:g} "

@@ -2,8 +2,11 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <memory>
+#include <vector>
 
 #include "bendlab/geometry/measures.hpp"
 #include "bendlab/surfaces/analytic_surface.hpp"
@@ -15,25 +18,28 @@ namespace {
 
 double default_aspect(const std::string& shape) { return shape == "oblate" ? 0.5 : shape == "prolate" ? 2.0 : 0.0; }
 
-void check_shape(const std::string& shape, double aspect, const char* shape_option, const char* aspect_option) {
+// aspect: none is the shape's default; any value given, 0 included, must fit the shape.
+void check_shape(const std::string& shape, std::optional<double> aspect, const char* shape_option,
+                 const char* aspect_option) {
   if (shape != "sphere" && shape != "rbc" && shape != "oblate" && shape != "prolate")
     throw Error(fmt::format("{} '{}': the shapes are sphere, rbc, oblate, prolate", shape_option, shape));
-  if (!std::isfinite(aspect)) throw Error(fmt::format("{} must be finite, got {}", aspect_option, aspect));
-  if (aspect == 0) return;
-  if (shape == "oblate" && !(aspect > 0 && aspect < 1))
-    throw Error(fmt::format("{} {}: an oblate spheroid needs c / a in (0, 1)", aspect_option, aspect));
-  if (shape == "prolate" && !(aspect > 1))
-    throw Error(fmt::format("{} {}: a prolate spheroid needs c / a > 1", aspect_option, aspect));
+  if (!aspect) return;
+  if (!std::isfinite(*aspect)) throw Error(fmt::format("{} must be finite, got {}", aspect_option, *aspect));
+  if (shape == "oblate" && !(*aspect > 0 && *aspect < 1))
+    throw Error(fmt::format("{} {}: an oblate spheroid needs c / a in (0, 1)", aspect_option, *aspect));
+  if (shape == "prolate" && !(*aspect > 1))
+    throw Error(fmt::format("{} {}: a prolate spheroid needs c / a > 1", aspect_option, *aspect));
   if (shape == "sphere" || shape == "rbc")
     throw Error(fmt::format("{} is for a spheroid (oblate, prolate), not the {}", aspect_option, shape));
 }
 
 /// The unit-size surface of a shape: radius 1 (sphere, rbc), half-axes (1, 1, aspect) (spheroids).
-std::unique_ptr<SurfaceOfRevolution> unit_surface(const std::string& shape, double aspect, double scale) {
+std::unique_ptr<SurfaceOfRevolution> unit_surface(const std::string& shape, std::optional<double> aspect,
+                                                  double scale) {
   std::unique_ptr<AnalyticSurface> s;
   if (shape == "rbc") s = make_rbc(scale);
   else if (shape == "sphere") s = make_sphere(scale);
-  else s = make_spheroid(scale, scale * (aspect == 0 ? default_aspect(shape) : aspect));
+  else s = make_spheroid(scale, scale * aspect.value_or(default_aspect(shape)));
   return std::unique_ptr<SurfaceOfRevolution>(static_cast<SurfaceOfRevolution*>(s.release()));
 }
 
@@ -60,7 +66,8 @@ ShapeMeasures measures_of(const SurfaceOfRevolution& s) {
 }
 
 /// The shape scaled to the volume 4 pi / 3 (initial), or to the area `area` (reference, area > 0).
-std::unique_ptr<SurfaceOfRevolution> scaled_surface(const std::string& shape, double aspect, double area) {
+std::unique_ptr<SurfaceOfRevolution> scaled_surface(const std::string& shape, std::optional<double> aspect,
+                                                    double area) {
   const ShapeMeasures unit = measures_of(*unit_surface(shape, aspect, 1.0));
   const double scale = area > 0 ? std::sqrt(area / unit.area) : std::cbrt(4 * M_PI / 3 / unit.volume);
   return unit_surface(shape, aspect, scale);
@@ -77,6 +84,34 @@ Points unit_directions(const TriMesh& mesh) {
   return u;
 }
 
+/// Refuses a mesh the map would fold. A shape is mapped from the directions u of the nodes seen
+/// from the volume centroid; for a mesh star-shaped about it every triangle of u turns as the
+/// outward normal does, u0 . (u1 x u2) > 0. A triangle whose value is not positive (to
+/// round-off against the mean) comes out of the map inverted or degenerate: the mapped surface
+/// would be folded, and a run on it meaningless.
+void check_unfolded(const TriMesh& mesh, const Points& u, const std::string& option, const std::string& shape) {
+  const Faces& faces = mesh.topology().faces();
+  std::vector<double> turn(static_cast<std::size_t>(faces.rows()));
+  double mean = 0;
+  for (Eigen::Index f = 0; f < faces.rows(); ++f) {
+    const Vec3 a = u.row(faces(f, 0)), b = u.row(faces(f, 1)), c = u.row(faces(f, 2));
+    turn[static_cast<std::size_t>(f)] = a.dot(b.cross(c));
+    mean += std::abs(turn[static_cast<std::size_t>(f)]);
+  }
+  mean /= std::max<double>(1.0, static_cast<double>(faces.rows()));
+  std::int64_t folded = 0, first = -1;
+  for (std::size_t f = 0; f < turn.size(); ++f)
+    if (!(turn[f] > 1e-9 * mean)) {
+      if (first < 0) first = static_cast<std::int64_t>(f);
+      ++folded;
+    }
+  if (folded > 0)
+    throw Error(fmt::format("{} {}: the mesh is not star-shaped about its volume centroid: mapped onto the shape, {} "
+                            "of its {} triangles would be inverted or degenerate (the first: triangle {}); a shape is "
+                            "mapped from a mesh of the sphere, or any closed mesh star-shaped about its centroid",
+                            option, shape, folded, faces.rows(), first));
+}
+
 }  // namespace
 
 std::vector<std::string> capsule_shape_names() { return {"sphere", "rbc", "oblate", "prolate"}; }
@@ -84,12 +119,12 @@ std::vector<std::string> capsule_shape_names() { return {"sphere", "rbc", "oblat
 void check_capsule_shape(const CapsuleShapeSpec& s) {
   check_shape(s.shape, s.aspect, "--shape", "--aspect");
   if (s.reference != "initial") check_shape(s.reference, s.reference_aspect, "--reference-shape", "--reference-aspect");
-  else if (s.reference_aspect != 0) throw Error("--reference-aspect is for a --reference-shape other than initial");
+  else if (s.reference_aspect) throw Error("--reference-aspect is for a --reference-shape other than initial");
   if (!std::isfinite(s.tilt_degrees) || std::abs(s.tilt_degrees) > 180)
     throw Error(fmt::format("--tilt must be an angle in degrees within [-180, 180], got {}", s.tilt_degrees));
 }
 
-ShapeMeasures capsule_shape_measures(const std::string& shape, double aspect) {
+ShapeMeasures capsule_shape_measures(const std::string& shape, std::optional<double> aspect) {
   check_shape(shape, aspect, "shape", "aspect");
   return measures_of(*scaled_surface(shape, aspect, 0));
 }
@@ -114,7 +149,7 @@ CapsuleGeometry shapes_of(const TriMesh& mesh, const CapsuleShapeSpec& s) {
   check_capsule_shape(s);
   const ShapeMeasures initial_measures = capsule_shape_measures(s.shape, s.aspect);
   CapsuleGeometry g{mesh, mesh.positions(), nlohmann::json::object()};
-  const double aspect = s.aspect == 0 ? default_aspect(s.shape) : s.aspect;
+  const double aspect = s.aspect.value_or(default_aspect(s.shape));
   g.description = {{"shape", s.shape},
                    {"tilt_degrees", s.tilt_degrees},
                    {"reference_shape", s.reference},
@@ -124,11 +159,13 @@ CapsuleGeometry shapes_of(const TriMesh& mesh, const CapsuleShapeSpec& s) {
   if (aspect != 0) g.description["aspect"] = aspect;
   if (s.is_default()) return g;
   const Points u = unit_directions(mesh);
+  if (s.shape != "sphere") check_unfolded(mesh, u, "--shape", s.shape);
+  else if (s.reference != "initial") check_unfolded(mesh, u, "--reference-shape", s.reference);
   Points initial = s.shape == "sphere" ? u : scaled_surface(s.shape, s.aspect, 0)->map_from_unit_sphere(u);
   Points reference = initial;
   if (s.reference != "initial") {
     reference = scaled_surface(s.reference, s.reference_aspect, initial_measures.area)->map_from_unit_sphere(u);
-    const double ra = s.reference_aspect == 0 ? default_aspect(s.reference) : s.reference_aspect;
+    const double ra = s.reference_aspect.value_or(default_aspect(s.reference));
     if (ra != 0) g.description["reference_aspect"] = ra;
   }
   // The sphere keeps the mesh's own nodes (a mesh file need not lie on the unit sphere).

@@ -2,7 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <cerrno>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <sstream>
 
@@ -15,25 +17,39 @@ const char* time_series_header() { return "gamma_t,D,theta,volume,area,E_bend,E_
 
 const char* legacy_time_series_header() { return "gamma_t,D,theta,volume,area,E_bend,E_elastic,dt"; }
 
+namespace {
+// v to `digits` significant digits, or "nan". A value so near the largest double that the
+// rounding passes it (1.79769313486232e+308 > 1.7976931348623157e+308: no double, and no reader
+// takes it) is written in its shortest exact form instead, so that every row reads back.
+std::string cell(double v, int digits) {
+  if (std::isnan(v)) return "nan";
+  std::string s = fmt::format("{:.{}g}", v, digits);
+  if (std::isfinite(v) && std::abs(v) > 1e308 && std::isinf(std::strtod(s.c_str(), nullptr))) s = fmt::format("{}", v);
+  return s;
+}
+}  // namespace
+
 std::string format_time_series_row(const TimeSeriesRow& r, bool legacy) {
-  const auto number = [](double v, int digits) {
-    return std::isnan(v) ? std::string("nan") : fmt::format("{:.{}g}", v, digits);
-  };
-  std::string s = fmt::format("{:.10g},{:.12g},{:.12g},{:.15g},{:.15g},{},{:.12g},{:.6g}", r.t, r.D, r.theta,
-                              r.volume, r.area, number(r.E_bend, 12), r.E_elastic, r.dt);
-  if (!legacy) s += fmt::format(",{},{}", number(r.axis_angle, 12), number(r.node_phase, 12));
+  std::string s = fmt::format("{},{},{},{},{},{},{},{}", cell(r.t, 10), cell(r.D, 12), cell(r.theta, 12),
+                              cell(r.volume, 15), cell(r.area, 15), cell(r.E_bend, 12), cell(r.E_elastic, 12),
+                              cell(r.dt, 6));
+  if (!legacy) s += fmt::format(",{},{}", cell(r.axis_angle, 12), cell(r.node_phase, 12));
   s += '\n';
   return s;
 }
 
 namespace {
+// Reads every number the writer writes. std::stod would refuse a subnormal (below 2.2e-308: an
+// energy of kS = 1/G at G = 1e308), for which strtod reports ERANGE; only an overflow, a number
+// beyond the doubles, is refused.
 double parse_number(const std::string& s, const std::string& source, std::int64_t line) {
   if (s == "nan") return std::numeric_limits<double>::quiet_NaN();
-  try {
-    std::size_t used = 0;
-    const double v = std::stod(s, &used);
-    if (used == s.size()) return v;
-  } catch (const std::exception&) {
+  if (!s.empty()) {
+    char* end = nullptr;
+    errno = 0;
+    const double v = std::strtod(s.c_str(), &end);
+    const bool overflow = errno == ERANGE && std::isinf(v);
+    if (end == s.c_str() + s.size() && !overflow) return v;
   }
   throw Error(fmt::format("'{}' line {}: '{}' is not a number", source, line, s.substr(0, 40)));
 }

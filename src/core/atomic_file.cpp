@@ -14,11 +14,30 @@
 
 namespace bendlab {
 
+namespace {
+// mkstemp's template suffix, and the characters glibc's mkstemp replaces it with.
+constexpr char kTempTemplate[] = "XXXXXX";
+constexpr std::size_t kTempSuffixLength = sizeof(kTempTemplate) - 1;
+bool is_temp_suffix_char(char c) {
+  return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9');
+}
+}  // namespace
+
 std::string atomic_temp_prefix(const std::filesystem::path& target) { return target.filename().string() + ".tmp"; }
+
+std::optional<std::string> atomic_temp_target(const std::string& name) {
+  static const std::string infix = ".tmp";
+  if (name.size() <= infix.size() + kTempSuffixLength) return std::nullopt;  // an empty target name too
+  const std::size_t at = name.size() - kTempSuffixLength - infix.size();
+  if (name.compare(at, infix.size(), infix) != 0) return std::nullopt;
+  for (std::size_t k = name.size() - kTempSuffixLength; k < name.size(); ++k)
+    if (!is_temp_suffix_char(name[k])) return std::nullopt;
+  return name.substr(0, at);
+}
 
 AtomicFile::AtomicFile(std::filesystem::path target, bool binary) : target_(std::move(target)), out_(nullptr) {
   std::filesystem::path pattern = target_;
-  pattern.replace_filename(atomic_temp_prefix(target_) + "XXXXXX");
+  pattern.replace_filename(atomic_temp_prefix(target_) + kTempTemplate);
   const std::string pattern_text = pattern.string();
   std::vector<char> name(pattern_text.begin(), pattern_text.end());
   name.push_back('\0');

@@ -179,6 +179,13 @@ CapsuleRunResult run_shear(const ShearRunSpec& a, const ShearRunCallbacks& callb
     in.kV_over_kS = kEspressoVolumeRatio;
     in.gamma_t_end = a.t_end;
     in.kernel = l.kernel == "phi2" ? lbm::IbKernel::Phi2 : l.kernel == "phi3" ? lbm::IbKernel::Phi3 : lbm::IbKernel::Phi4;
+    // The box must hold the shape as it starts, not only the sphere: a tilted prolate spheroid is
+    // longer along x than 2 R. The sphere keeps its radius 1, as always.
+    if (a.shape.shape != "sphere") {
+      const Vec3 centre = volume_centroid(mesh.topology(), geometry.initial);
+      for (int k = 0; k < 3; ++k)
+        in.half_extent[static_cast<std::size_t>(k)] = (geometry.initial.col(k).array() - centre[k]).abs().maxCoeff();
+    }
     const lbm::CapsuleRunParameters p = lbm::capsule_run_parameters(in);
     if (callbacks.on_note)
       for (const std::string& w : p.warnings) callbacks.on_note("warning: " + w);
@@ -257,10 +264,11 @@ CapsuleRunResult run_shear(const ShearRunSpec& a, const ShearRunCallbacks& callb
   // or reference is part of it.
   if (!a.shape.is_default()) {
     o.arguments["shape"] = a.shape.shape;
-    o.arguments["aspect"] = a.shape.aspect;
+    // An aspect not given is recorded as 0, as it always was (0 itself is refused).
+    o.arguments["aspect"] = a.shape.aspect.value_or(0.0);
     o.arguments["tilt"] = a.shape.tilt_degrees;
     o.arguments["reference_shape"] = a.shape.reference;
-    o.arguments["reference_aspect"] = a.shape.reference_aspect;
+    o.arguments["reference_aspect"] = a.shape.reference_aspect.value_or(0.0);
   }
   for (const auto& [key, value] : lattice_arguments.items()) o.arguments[key] = value;
   summary_fields["membrane_law"] = a.membrane;

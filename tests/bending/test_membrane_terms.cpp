@@ -292,5 +292,27 @@ TEST(MembraneTerms, RefusesBadParametersAndMethodA) {
   }
 }
 
+TEST(MembraneTerms, AnOverflowingAdeTermIsRefusedNamingIt) {
+  // d = 1e-300 with dA0 = 0.1 puts M0 = dA0 / (2 d) at 5e298: the term alpha pi kB (M - M0)^2 /
+  // (2 A) is no number. Refused as the ADE term, not found later as a failing run.
+  BendingParameters p = params(1.0, 0.0, 1.0, 12.0);
+  p.ade_d = 1e-300;
+  try {
+    p.validate();
+    ADD_FAILURE() << "accepted d = 1e-300";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("ADE term"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("d = 1e-300"), std::string::npos) << e.what();
+  }
+  p.ade_alpha = 1e308;  // the coefficient alone overflows
+  p.ade_d = 0.02;
+  p.ade_area = 1e-10;
+  EXPECT_THROW(p.validate(), Error);
+  p = params(1.0, 0.0, 1.0, 12.0);
+  p.ade_d = 1e-300;
+  p.ade_da0 = 0;  // M0 = 0: a tiny d alone is harmless
+  EXPECT_NO_THROW(p.validate());
+}
+
 }  // namespace
 }  // namespace bendlab

@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "bendlab/capsule/capsule_run.hpp"
 #include "bendlab/capsule/checkpoint.hpp"
@@ -100,6 +102,36 @@ TEST(SteadyStatistics, WindowAndWeightedMeans) {
     FAIL();
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("D_dt"), std::string::npos) << e.what();
+  }
+}
+
+TEST(TimeSeries, WhateverTheWriterWritesTheReaderReads) {
+  // The extremes a run can produce: subnormals (energies of kS = 1/G at G = 1e308 came out as
+  // 1.23301775164e-314), the largest and smallest normal numbers (the largest to 15 digits,
+  // 1.79769313486232e+308, would be past it), infinities, signed zeros. Each row reads back to a
+  // row that is written as the very same text.
+  using L = std::numeric_limits<double>;
+  for (const double v : {L::denorm_min(), 1.23301775164e-314, -2.5e-320, L::min(), -L::min(), L::max(), -L::max(),
+                         L::infinity(), -L::infinity(), 0.0, -0.0, 1e-300}) {
+    const TimeSeriesRow row{0.5, v, v, v, v, v, v, 0.01, v, v};
+    const std::string line = format_time_series_row(row);
+    std::vector<TimeSeriesRow> back;
+    ASSERT_NO_THROW(back = parse_time_series(std::string(time_series_header()) + "\n" + line, "t.csv")) << line;
+    ASSERT_EQ(back.size(), 1u);
+    EXPECT_EQ(format_time_series_row(back[0]), line);
+    if (v != 0 && std::isfinite(v)) {
+      EXPECT_NE(back[0].D, 0.0) << line;
+    }
+  }
+  // Numbers beyond the doubles are still refused, naming the line.
+  for (const char* cell : {"1e400", "-1e999"}) {
+    const std::string text = std::string(time_series_header()) + "\n0.5," + cell + ",0,0,0,0,0,0.01,0,0\n";
+    try {
+      parse_time_series(text, "t.csv");
+      ADD_FAILURE() << cell;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("line 2"), std::string::npos) << e.what();
+    }
   }
 }
 
@@ -373,7 +405,7 @@ TEST_F(CapsuleRun, ResumeRemovesTheRunsStaleTemporariesOnly) {
   o.stop_after_steps = 3;
   ASSERT_FALSE(run_capsule(*s, o).finished);
   // What a kill during writes leaves, and a file of someone else's.
-  for (const char* f : {"snapshot_00001.vtp.tmpAb3dEf", "timeseries.csv.tmp4242", "checkpoint.json.tmpZZZZZZ"})
+  for (const char* f : {"snapshot_00001.vtp.tmpAb3dEf", "timeseries.csv.tmp4242zz", "checkpoint.json.tmpZZZZZZ"})
     spit(run / f, "half");
   spit(run / "mine.tmp", "keep");
   auto again = solver();
@@ -384,6 +416,65 @@ TEST_F(CapsuleRun, ResumeRemovesTheRunsStaleTemporariesOnly) {
     EXPECT_TRUE(e.path().filename() == "mine.tmp" || e.path().filename().string().find(".tmp") == std::string::npos)
         << e.path();
   EXPECT_EQ(slurp(run / "mine.tmp"), "keep");
+}
+
+TEST_F(CapsuleRun, ResumeAndOverwriteKeepFilesThatOnlyLookLikeTemporaries) {
+  // Only "<output>.tmp" and mkstemp's six letters or digits can be a temporary of the run; any
+  // other name after ".tmp" is a file of the user's, and survives --resume and --overwrite.
+  // A step of a short run and its resume: cheap under the sanitizers.
+  const fs::path run = dir / "run";
+  auto s = solver();
+  CapsuleRunOptions o = options(run, 0.01);
+  o.stop_after_steps = 1;
+  ASSERT_FALSE(run_capsule(*s, o).finished);
+  const std::vector<std::string> users = {"timeseries.csv.tmp-backup-2024", "summary.json.tmp.mine",
+                                          "checkpoint.json.tmp", "D_theta.png.tmp_by_user.png",
+                                          "timing.json.tmp12345", "shapes.pvd.tmpABCDEFG"};
+  for (const std::string& f : users) spit(run / f, "user's " + f);
+  spit(run / "timeseries.csv.tmpQ9x2Lm", "half");  // a temporary of a killed write
+  auto again = solver();
+  o.stop_after_steps = 0;
+  o.resume = true;
+  ASSERT_TRUE(run_capsule(*again, o).finished);
+  EXPECT_FALSE(fs::exists(run / "timeseries.csv.tmpQ9x2Lm"));
+  for (const std::string& f : users) EXPECT_EQ(slurp(run / f), "user's " + f) << f << " after --resume";
+  auto third = solver();  // --overwrite removes the old run's files as it starts: one step shows it
+  o.resume = false;
+  o.overwrite = true;
+  o.stop_after_steps = 1;
+  ASSERT_FALSE(run_capsule(*third, o).finished);
+  EXPECT_FALSE(fs::exists(run / "summary.json"));
+  for (const std::string& f : users) EXPECT_EQ(slurp(run / f), "user's " + f) << f << " after --overwrite";
+}
+
+TEST_F(CapsuleRun, AResumeToTheCheckpointsOwnEndWritesTheMissingSummary) {
+  // A run stopped between its final checkpoint and summary.json (a kill, a failed summary write)
+  // is completed by a resume with the same t_end: the summary the whole run would have written.
+  const fs::path run = dir / "run";
+  auto s = solver();
+  const CapsuleRunResult whole = run_capsule(*s, options(run, 0.02));
+  ASSERT_TRUE(whole.finished);
+  const std::string series = slurp(run / "timeseries.csv");
+  fs::remove(run / "summary.json");
+  fs::remove(run / "timing.json");
+  auto again = solver();
+  CapsuleRunOptions o = options(run, 0.02);
+  o.resume = true;
+  const CapsuleRunResult completed = run_capsule(*again, o);
+  ASSERT_TRUE(completed.finished);
+  EXPECT_EQ(completed.summary, whole.summary);
+  EXPECT_EQ(nlohmann::json::parse(slurp(run / "summary.json")), whole.summary);
+  EXPECT_TRUE(fs::exists(run / "timing.json"));
+  EXPECT_EQ(slurp(run / "timeseries.csv"), series);  // no step taken, no row added
+  // An end before the checkpoint's is still refused.
+  auto earlier = solver();
+  o.t_end = 0.015;
+  try {
+    run_capsule(*earlier, o);
+    ADD_FAILURE() << "resumed to an earlier end";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("is before the checkpoint"), std::string::npos) << e.what();
+  }
 }
 
 TEST_F(CapsuleRun, AFolderWhoseParentIsMissingIsRefused) {
@@ -439,15 +530,16 @@ TEST_F(CapsuleRun, ManyRunsInOneProcess) {
   }
 }
 
-TEST_F(CapsuleRun, ResumeToAnEarlierOrEqualEndIsRefusedBeforeAnyChange) {
-  // Resuming a run that reached gamma t = 0.15 with t_end <= 0.15 would write a summary of a run
-  // that did not end at t_end: refused, and the folder stays as it was.
+TEST_F(CapsuleRun, ResumeToAnEarlierEndIsRefusedBeforeAnyChange) {
+  // Resuming a run that reached gamma t = 0.15 with t_end < 0.15 would write a summary of a run
+  // that did not end at t_end: refused, and the folder stays as it was. (t_end = 0.15 completes
+  // the run's files: AResumeToTheCheckpointsOwnEndWritesTheMissingSummary.)
   auto s = solver();
   const fs::path run = dir / "run";
   ASSERT_TRUE(run_capsule(*s, options(run, 0.15)).finished);
   const std::string series = slurp(run / "timeseries.csv"), checkpoint = slurp(run / "checkpoint.json"),
                     summary = slurp(run / "summary.json");
-  for (double t_end : {0.15, 0.1}) {
+  for (double t_end : {0.15 - 1e-9, 0.1}) {
     CapsuleRunOptions o = options(run, t_end);
     o.resume = true;
     auto fresh = solver();
@@ -455,7 +547,7 @@ TEST_F(CapsuleRun, ResumeToAnEarlierOrEqualEndIsRefusedBeforeAnyChange) {
       run_capsule(*fresh, o);
       ADD_FAILURE() << "resumed to t_end = " << t_end;
     } catch (const Error& e) {
-      EXPECT_NE(std::string(e.what()).find("is not after the checkpoint's gamma t"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("is before the checkpoint's gamma t"), std::string::npos) << e.what();
     }
     EXPECT_EQ(slurp(run / "timeseries.csv"), series);
     EXPECT_EQ(slurp(run / "checkpoint.json"), checkpoint);

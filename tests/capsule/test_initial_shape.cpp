@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
 
 #include "bendlab/capsule/capsule_shape.hpp"
 #include "bendlab/capsule/initial_shape.hpp"
@@ -114,6 +115,56 @@ TEST(InitialShape, BadSpecificationsAreRefusedNamingTheOption) {
   s = spec("rbc");
   s.reference_aspect = 0.5;
   refused(s, "--reference-aspect");
+}
+
+TEST(InitialShape, AZeroAspectIsRefusedNotTakenForTheDefault) {
+  // c/a = 0 is no spheroid; it must not run as the default 0.5 (oblate) or 2 (prolate).
+  for (const char* shape : {"oblate", "prolate"}) {
+    CapsuleShapeSpec s = spec(shape);
+    s.aspect = 0;
+    EXPECT_THROW(check_capsule_shape(s), Error) << shape;
+    try {
+      check_capsule_shape(s);
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("--aspect 0"), std::string::npos) << e.what();
+    }
+    CapsuleShapeSpec r = spec("rbc", 0, shape);
+    r.reference_aspect = 0;
+    try {
+      check_capsule_shape(r);
+      ADD_FAILURE() << "--reference-aspect 0 accepted for " << shape;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("--reference-aspect 0"), std::string::npos) << e.what();
+    }
+  }
+  // Not given: the defaults.
+  const ShapeMeasures o = capsule_shape_measures("oblate");
+  EXPECT_NEAR(o.height / o.radial, 0.5, 1e-12);
+}
+
+TEST(InitialShape, AMeshThatIsNotStarShapedAboutItsCentroidIsNotMapped) {
+  // The 320-triangle sphere with its cap above z = 0.3 pushed in (z -> 0.6 - z): a closed
+  // surface, but seen from its centroid the dent's nodes lie beyond the rim, so the map onto a
+  // shape would fold the dent over (inverted triangles). Refused, naming --shape (or
+  // --reference-shape).
+  const TriMesh sphere = sphere_mesh(MeshFamily::MT1, 2);
+  Points x = sphere.positions();
+  for (Eigen::Index i = 0; i < x.rows(); ++i)
+    if (x(i, 2) > 0.3) x(i, 2) = 0.6 - x(i, 2);
+  const TriMesh dented(sphere.topology_ptr(), x);
+  ASSERT_GT(enclosed_volume(dented.topology(), x), 0);
+  for (const CapsuleShapeSpec& s : {spec("rbc"), spec("oblate", 30), spec("sphere", 0, "rbc")}) {
+    try {
+      capsule_geometry(dented, s);
+      ADD_FAILURE() << "mapped a mesh that is not star-shaped onto " << s.shape << " / " << s.reference;
+    } catch (const Error& e) {
+      const std::string option = s.shape == "sphere" ? "--reference-shape " : "--shape ";
+      EXPECT_NE(std::string(e.what()).find(option), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("inverted"), std::string::npos) << e.what();
+    }
+  }
+  // The sphere itself, only tilted, is not mapped: the dented mesh runs as it is.
+  EXPECT_NO_THROW(capsule_geometry(dented, spec("sphere", 30)));
 }
 
 TEST(InitialShape, AStressFreeBiconcaveReferenceHasNoElasticForceASphericalOneHas) {

@@ -611,19 +611,25 @@ TEST_F(Cli, ShearRefusesLooseTolerancesAndWarnsAboutLooseOnes) {
   EXPECT_NE(r.err.find("warning: --rtol 0.001 is above 0.0001"), std::string::npos) << r.err;
 }
 
-TEST_F(Cli, ShearResumeToAnEarlierOrEqualEndIsRefused) {
+TEST_F(Cli, ShearResumeToAnEarlierEndIsRefusedAndToItsOwnEndCompletesTheRun) {
   const fs::path out = dir / "run";
   const std::string common = "shear --mesh mt1:320 --snapshot-every 0.01 --no-plot --out " + out.string();
   ASSERT_EQ(run(common + " --t-end 0.02").status, 0);
   const std::string summary = slurp(out / "summary.json"), series = slurp(out / "timeseries.csv");
-  for (const char* t_end : {"0.02", "0.01"}) {
+  for (const char* t_end : {"0.0199", "0.01"}) {
     const CliRun r = run(common + " --resume --t-end " + t_end);
     EXPECT_NE(r.status, 0);
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
-    EXPECT_NE(r.err.find("is not after the checkpoint's gamma t"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("is before the checkpoint's gamma t"), std::string::npos) << r.err;
     EXPECT_EQ(slurp(out / "summary.json"), summary);
     EXPECT_EQ(slurp(out / "timeseries.csv"), series);
   }
+  // Stopped between the final checkpoint and summary.json: a resume to the same end writes it.
+  fs::remove(out / "summary.json");
+  const CliRun r = run(common + " --resume --t-end 0.02");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(slurp(out / "summary.json"), summary);
+  EXPECT_EQ(slurp(out / "timeseries.csv"), series);
 }
 
 TEST_F(Cli, ShearSkalakLawIsRecordedAndPartOfTheRunsIdentity) {
@@ -797,4 +803,61 @@ TEST_F(Cli, ShearShapeOptionsAreCheckedAndPartOfTheRunsIdentity) {
   const auto l = nlohmann::json::parse(slurp(lbm / "summary.json"));
   EXPECT_EQ(l.at("reference_shape"), "oblate");
   EXPECT_NEAR(l.at("initial_volume").get<double>(), l.at("capsule_shape").at("mesh_volume").get<double>(), 1e-12);
+}
+
+// What a hostile-input probe found: shapes, numbers and messages.
+
+TEST_F(Cli, ShearRefusesAZeroAspectAndABoxShorterThanTheShape) {
+  const fs::path out = dir / "run";
+  expect_refused(run("shear --shape oblate --aspect 0 --mesh mt1:320 --out " + out.string()), "--aspect 0", out);
+  expect_refused(run("shear --shape rbc --reference-shape oblate --reference-aspect 0 --mesh mt1:320 --out " +
+                     out.string()),
+                 "--reference-aspect 0", out);
+  // A prolate spheroid of c/a = 4 lying along x is 15 nodes long at R = 3: a 9-node period would
+  // hold it overlapping its own image.
+  expect_refused(run("shear --solver lbm --shape prolate --aspect 4 --tilt 90 --mesh mt1:320 --radius-lu 3 "
+                     "--box 3,3,4 --out " + out.string()),
+                 "box x of 9 nodes does not contain the capsule", out);
+}
+
+TEST_F(Cli, SeedsAreWholeNumbersWithinTheirRange) {
+  const fs::path out = dir / "m.off", study = dir / "study";
+  // CLI11 took each of these for 2^64 - 1. (Every unsigned option has the same check: rbc's once.)
+  for (const char* seed : {"-1", "18446744073709551616", "1e23", "1.5"})
+    expect_refused(run({"mesh", "--family", "irregular", "--level", "1", "--jitter-seed", seed, "--out", out.string()}),
+                   "--jitter-seed", out);
+  expect_refused(run({"rbc", "--families", "irregular", "--max-triangles", "320", "--methods", "C", "--jitter-seed",
+                      "-1", "--no-plots", "--out", study.string()}),
+                 "--jitter-seed", study);
+  const CliRun r = run("mesh --family irregular --level 1 --jitter-seed 18446744073709551614 --out " + out.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  // Level 1 uses the base seed + 1: the largest seed there is.
+  EXPECT_EQ(nlohmann::json::parse(r.out).at("jitter_seed").get<std::uint64_t>(), 18446744073709551615ull);
+}
+
+TEST_F(Cli, ShearNamesAnOverflowingAdeTermBeforeWork) {
+  const fs::path out = dir / "run";
+  expect_refused(run("shear --method C --mesh mt1:320 --kappa-b-hat 0.05 --ade-alpha 1 --ade-d 1e-300 --ade-da0 0.1 "
+                     "--t-end 0.05 --no-plot --out " + out.string()),
+                 "ADE term", out);
+}
+
+TEST_F(Cli, RbcRefusesAnOverflowingForceLawBeforeWork) {
+  // The exact force density of c0 = 1e308 overflows: refused before the study starts, naming the
+  // option, and without the output folder.
+  const fs::path study = dir / "study";
+  expect_refused(run("rbc --families mt1 --max-triangles 320 --methods C --c0 1e308 --no-plots --out " +
+                     study.string()),
+                 "--c0", study);
+}
+
+TEST_F(Cli, RbcWithAPythonThatCannotStartWarnsAndSucceeds) {
+  // The data files are the results; a plot not made is a warning, whatever the reason.
+  const fs::path study = dir / "study";
+  const CliRun r = run({"rbc", "--families", "mt1", "--max-triangles", "320", "--methods", "C", "--python",
+                        "/nonexistent/python3", "--out", study.string()});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("warning: the plots were not made"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("/nonexistent/python3"), std::string::npos) << r.err;
+  EXPECT_TRUE(fs::is_regular_file(study / "errors.csv"));
 }

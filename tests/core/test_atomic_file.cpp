@@ -7,6 +7,7 @@
 #include <csignal>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <set>
 #include <string>
@@ -110,4 +111,22 @@ TEST_F(AtomicFileTest, AWriteBeyondTheFileSizeLimitIsAnErrorAndLeavesNothing) {
   std::signal(SIGXFSZ, old_handler);
   EXPECT_NE(message.find("big.vtp"), std::string::npos) << message;
   EXPECT_TRUE(others({}).empty());
+}
+
+TEST_F(AtomicFileTest, OnlyMkstempsNamesAreTakenForTemporaries) {
+  // The name a temporary really has is recognised, with its target.
+  const fs::path target = dir / "timeseries.csv";
+  {
+    AtomicFile f(target);
+    const std::vector<std::string> names = others({});
+    ASSERT_EQ(names.size(), 1u);
+    EXPECT_EQ(atomic_temp_target(names[0]), std::optional<std::string>("timeseries.csv")) << names[0];
+  }
+  EXPECT_EQ(atomic_temp_target("snapshot_00001.vtp.tmpAb3dEf"), std::optional<std::string>("snapshot_00001.vtp"));
+  EXPECT_EQ(atomic_temp_target("a.tmp.tmp09AZaz"), std::optional<std::string>("a.tmp"));
+  // Anything else after ".tmp" is no temporary of AtomicFile: a user's file.
+  for (const char* name : {"timeseries.csv.tmp-backup-2024", "summary.json.tmp.mine", "checkpoint.json.tmp",
+                           "D_theta.png.tmp_by_user.png", "timing.json.tmp12345", "shapes.pvd.tmpABCDEFG",
+                           "x.tmpab-def", ".tmpAbCdEf", "timeseries.csv", "tmpAbCdEf"})
+    EXPECT_EQ(atomic_temp_target(name), std::nullopt) << name;
 }

@@ -65,6 +65,26 @@ TEST(CapsuleRunParameters, RejectsBadSetups) {
   EXPECT_EQ(error_of(in), "");
 }
 
+TEST(CapsuleRunParameters, TheBoxMustHoldTheShapesExtentNotTheSpheres) {
+  // A prolate spheroid c/a = 4 of the unit sphere's volume, its axis along x (tilt 90): half-axes
+  // 4^(2/3) = 2.52 along x and 4^(-1/3) = 0.63 across. At R = 3 it is 15 nodes long: a period of
+  // 9 nodes (box 3 R) would overlap it with its own image.
+  CapsuleRunInput in;
+  in.radius = 3;
+  in.box_x = 3;
+  in.box_y = 3;
+  in.box_z = 4;
+  EXPECT_EQ(error_of(in), "");  // the sphere of radius R fits
+  in.half_extent = {std::cbrt(16.0), std::cbrt(0.25), std::cbrt(0.25)};
+  EXPECT_NE(error_of(in).find("box x of 9 nodes does not contain the capsule"), std::string::npos) << error_of(in);
+  in.box_x = 6;  // 18 nodes > 2 (3 * 2.52 + 1)
+  EXPECT_EQ(error_of(in), "");
+  // Upright (tilt 0) the same body reaches for the walls.
+  in.half_extent = {std::cbrt(0.25), std::cbrt(0.25), std::cbrt(16.0)};
+  in.box_z = 5;  // the walls at +-7.5 against 3 * 2.52 + 1
+  EXPECT_NE(error_of(in).find("touches the walls"), std::string::npos) << error_of(in);
+}
+
 TEST(CapsuleRunParameters, WarnsAboveThePapersReynoldsNumber) {
   CapsuleRunInput in;
   in.reynolds = 0.5;

@@ -43,7 +43,8 @@ struct BendingParameters {
   /// E_ADE = alpha pi kB (M - M0)^2 / (2 A) (0 without ADE).
   double ade_energy(double M) const;
   /// Refuses with a one-line bendlab::Error: non-finite kB or c0, negative alpha, and with
-  /// alpha > 0 a leaflet distance or area that is not positive and finite, or a non-finite dA0.
+  /// alpha > 0 a leaflet distance or area that is not positive and finite, a non-finite dA0, or
+  /// an ADE term that overflows (its coefficient, or the term at M = 0: M0 = dA0 / (2 d) huge).
   void validate() const;
   /// "c0 = 0.5, ADE alpha = 2, d = 0.01, dA0 = 0, A = 12.6" (for logs and run identities).
   std::string describe() const;

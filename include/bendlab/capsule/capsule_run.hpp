@@ -101,7 +101,8 @@ TimeSeriesRow capsule_sample(const MembraneModel& membrane, const Points& x, dou
 CapsuleRunResult run_capsule(CapsuleSolver& solver, const CapsuleRunOptions& options);
 
 /// Whether `name` is a file a capsule run writes into its folder (with `solver`'s side files), or
-/// a temporary of one: the files --overwrite removes.
+/// a temporary the run can have made for one (core/atomic_file.hpp's atomic_temp_target, or a
+/// side file's "<name>.tmp"): the files --overwrite removes. Other names are never the run's.
 bool is_run_file(const std::string& name, const CapsuleSolver& solver);
 
 /// Whether two argument sets are equal (same keys; numbers to 1e-12 relative); otherwise the first

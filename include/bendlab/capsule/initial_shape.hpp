@@ -17,6 +17,7 @@
 // (sin tilt, 0, cos tilt), in the shear plane x-z, tilted from e_z towards e_x (the sense in which
 // the shear flow u = gamma z e_x turns a body).
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -27,10 +28,10 @@ namespace bendlab {
 
 struct CapsuleShapeSpec {
   std::string shape = "sphere";      ///< initial shape: sphere, rbc, oblate, prolate
-  double aspect = 0;                 ///< c / a of a spheroid; 0: the default (oblate 0.5, prolate 2)
+  std::optional<double> aspect;      ///< c / a of a spheroid; none: the default (oblate 0.5, prolate 2)
   double tilt_degrees = 0;           ///< angle of the axis of symmetry from e_z towards e_x, in [-180, 180]
   std::string reference = "initial";  ///< stress-free shape: initial (the initial one), or a shape name
-  double reference_aspect = 0;       ///< c / a of a spheroidal reference; 0: the default
+  std::optional<double> reference_aspect;  ///< c / a of a spheroidal reference; none: the default
   /// The sphere, untilted, stress-free as it starts: the paper's capsule.
   bool is_default() const { return shape == "sphere" && tilt_degrees == 0 && reference == "initial"; }
 };
@@ -40,8 +41,8 @@ std::vector<std::string> capsule_shape_names();
 
 /// Throws bendlab::Error with a one-line message naming the option (--shape, --aspect, --tilt,
 /// --reference-shape, --reference-aspect) for an unknown shape, an aspect ratio that does not fit
-/// the shape (oblate: in (0, 1), prolate: > 1, none for sphere and rbc), a tilt out of range or
-/// not finite.
+/// the shape (oblate: in (0, 1), prolate: > 1, none for sphere and rbc; 0 is refused, not taken for
+/// the default), a tilt out of range or not finite.
 void check_capsule_shape(const CapsuleShapeSpec& spec);
 
 struct CapsuleGeometry {
@@ -54,7 +55,10 @@ struct CapsuleGeometry {
 
 /// The initial and reference shapes of `spec` on the nodes of `mesh` (a closed mesh of the unit
 /// sphere, or any closed star-shaped mesh: its nodes are normalised about its volume centroid).
-/// For the default spec, both are mesh.positions() unchanged. Checks spec as check_capsule_shape.
+/// For the default spec, both are mesh.positions() unchanged. Checks spec as check_capsule_shape,
+/// and refuses (naming --shape or --reference-shape) a mesh that the map onto a shape would fold:
+/// one not star-shaped about its centroid, whose directions from it give a triangle that is
+/// inverted or degenerate.
 CapsuleGeometry capsule_geometry(const TriMesh& mesh, const CapsuleShapeSpec& spec);
 
 /// Analytic volume and area of a shape of spec (before tilting; the sphere: 4 pi / 3 and 4 pi).
@@ -62,6 +66,6 @@ struct ShapeMeasures {
   double volume = 0, area = 0, reduced_volume = 0;
   double radial = 0, height = 0;  ///< largest radius about the axis and largest |z| (half-thickness)
 };
-ShapeMeasures capsule_shape_measures(const std::string& shape, double aspect = 0);
+ShapeMeasures capsule_shape_measures(const std::string& shape, std::optional<double> aspect = std::nullopt);
 
 }  // namespace bendlab

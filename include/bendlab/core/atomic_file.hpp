@@ -10,6 +10,7 @@
 
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <ostream>
 #include <string>
 
@@ -18,6 +19,12 @@ namespace bendlab {
 /// The start of the name of every temporary file of target ("<target name>.tmp"), for finding
 /// the temporaries an interrupted writer left behind.
 std::string atomic_temp_prefix(const std::filesystem::path& target);
+
+/// The name of the target whose temporary `name` is: "<target name>.tmp" followed by exactly the
+/// six characters mkstemp puts for "XXXXXX" (letters A-Z, a-z and digits), else nothing. Only
+/// such a name can be a temporary of AtomicFile; "a.csv.tmp", "a.csv.tmp-backup" or
+/// "a.csv.tmp_mine.png" are someone else's files.
+std::optional<std::string> atomic_temp_target(const std::string& name);
 
 class AtomicFile {
  public:

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <tuple>
 
 namespace bendlab::lbm {
 
@@ -42,14 +43,20 @@ CapsuleRunParameters capsule_run_parameters(const CapsuleRunInput& in) {
   p.nx = nodes(in.box_x, "x");
   p.ny = nodes(in.box_y, "y");
   p.nz = nodes(in.box_z, "z");
-  // The capsule's diameter plus the kernel support on both sides must fit in a periodic period.
-  for (auto [n, axis] : {std::pair{p.nx, "x"}, std::pair{p.ny, "y"}}) {
-    if (n < 2.0 * (R + h)) {
-      throw Error(fmt::format("box {} of {} nodes does not contain the capsule (diameter {} plus kernel support {})", axis, n, 2 * R, 2 * h));
+  for (double e : in.half_extent)
+    if (!(e > 0) || !std::isfinite(e)) throw Error(fmt::format("the capsule's half-extent {} R must be positive", e));
+  // The capsule's extent along the axis (the sphere's diameter, a shape's own) plus the kernel
+  // support on both sides must fit in a periodic period, or it overlaps its own image.
+  for (auto [n, e, axis] : {std::tuple{p.nx, in.half_extent[0], "x"}, std::tuple{p.ny, in.half_extent[1], "y"}}) {
+    if (n < 2.0 * (R * e + h)) {
+      throw Error(fmt::format("box {} of {} nodes does not contain the capsule (extent {:.4g} plus kernel support {})",
+                              axis, n, 2 * R * e, 2 * h));
     }
   }
-  if (0.5 * p.nz <= R + h) {
-    throw Error(fmt::format("capsule (R = {} plus kernel half-width {}) touches the walls at z = +-{}", R, h, 0.5 * p.nz));
+  if (0.5 * p.nz <= R * in.half_extent[2] + h) {
+    throw Error(fmt::format("capsule (reaching {:.4g} from its centre, plus kernel half-width {}) touches the walls at "
+                            "z = +-{}",
+                            R * in.half_extent[2], h, 0.5 * p.nz));
   }
   p.tau = in.tau;
   p.nu = (in.tau - 0.5) / 3.0;

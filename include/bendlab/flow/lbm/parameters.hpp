@@ -6,6 +6,7 @@
 //   gamma = 2 v / nz, Ma = v sqrt(3), Re_p = gamma R^2 / nu;
 //   kS = mu gamma R / G, kB = kB_hat R^2 kS, kV = 100 kS (ESPResSo's volume force);
 //   steps = ceil(gamma_t_end / gamma).
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -25,6 +26,9 @@ struct CapsuleRunInput {
   double kV_over_kS = 100.0;   ///< the paper's kappa_V = 100 kappa_S
   double gamma_t_end = 10.0;
   IbKernel kernel = IbKernel::Phi2;  ///< its half-width counts towards the clearances
+  /// The capsule's reach from its centre along x, y, z in multiples of R: 1 for the sphere; a
+  /// shape's own (a prolate spheroid of c/a = 4 along x: 2.52, 0.63, 0.63).
+  std::array<double, 3> half_extent = {1.0, 1.0, 1.0};
 };
 
 struct CapsuleRunParameters {
@@ -40,9 +44,9 @@ struct CapsuleRunParameters {
   LatticeConfig lattice_config() const;
 };
 
-/// Throws bendlab::Error for tau <= 1/2, a non-positive R, G, Re or negative kB_hat, a box axis
-/// that cannot hold the capsule (2R plus the kernel support), a capsule touching a wall
-/// (nz/2 <= R + kernel half-width), and Ma > 0.1.
+/// Throws bendlab::Error for tau <= 1/2, a non-positive R, G, Re or negative kB_hat, a periodic box
+/// axis that cannot hold the capsule (its extent 2 R half_extent plus the kernel support), a
+/// capsule touching a wall (nz/2 <= R half_extent_z + kernel half-width), and Ma > 0.1.
 CapsuleRunParameters capsule_run_parameters(const CapsuleRunInput& input);
 
 }  // namespace bendlab::lbm
