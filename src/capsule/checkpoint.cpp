@@ -5,6 +5,7 @@
 #include <cmath>
 #include <fstream>
 #include <regex>
+#include <set>
 #include <sstream>
 
 #include "bendlab/core/atomic_file.hpp"
@@ -53,7 +54,7 @@ struct Reader {
 
 nlohmann::json CapsuleCheckpoint::to_json() const {
   std::vector<double> flat(positions.data(), positions.data() + positions.size());
-  return {{"format", kFormat},
+  nlohmann::json j = {{"format", kFormat},
           {"version", kVersion},
           {"arguments", arguments},
           {"solver", solver},
@@ -63,10 +64,14 @@ nlohmann::json CapsuleCheckpoint::to_json() const {
           {"steps", steps},
           {"wall_seconds", wall_seconds},
           {"counters", {{"rejected_steps", counters.rejected_steps}, {"velocity_evaluations", counters.velocity_evaluations}}},
-          {"steady", steady.to_json()},
           {"snapshots", snapshots},
           {"solver_state", solver_state.fields},
           {"side_files", solver_state.side_files}};
+  for (const auto& [key, value] : recorder.items()) {
+    if (j.contains(key)) throw Error(fmt::format("checkpoint: the recorder's key \"{}\" is the checkpoint's own", key));
+    j[key] = value;
+  }
+  return j;
 }
 
 CapsuleCheckpoint CapsuleCheckpoint::from_json(const nlohmann::json& j, int num_vertices, const std::string& source) {
@@ -110,9 +115,6 @@ CapsuleCheckpoint CapsuleCheckpoint::from_json(const nlohmann::json& j, int num_
     c.counters.rejected_steps = cj.at("rejected_steps").get<std::int64_t>();
     c.counters.velocity_evaluations = cj.at("velocity_evaluations").get<std::int64_t>();
   }
-  c.steady = SteadyStatistics::from_json(r.object("steady"), source + ": \"steady\"");
-  if (c.steady.count() > c.steps)
-    r.fail("steady", fmt::format("counts {} rows in the window but the run has {} steps", c.steady.count(), c.steps));
   const auto& s = r.at("snapshots");
   if (!s.is_array()) r.fail("snapshots", "must be an array of [time, file] pairs");
   static const std::regex name_re(R"(snapshot_\d{5,}\.vtp)");
@@ -139,6 +141,11 @@ CapsuleCheckpoint CapsuleCheckpoint::from_json(const nlohmann::json& j, int num_
       r.fail("side_files", fmt::format("entry {} must be a plain file name in the run folder", f.dump()));
     c.solver_state.side_files.push_back(f.get<std::string>());
   }
+  static const std::set<std::string> own = {"format",        "version",  "arguments", "solver",       "time",
+                                            "vertices",      "positions", "steps",    "wall_seconds", "counters",
+                                            "snapshots",     "solver_state", "side_files"};
+  for (const auto& [key, value] : j.items())
+    if (!own.count(key)) c.recorder[key] = value;
   return c;
 }
 

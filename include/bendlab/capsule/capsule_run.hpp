@@ -1,5 +1,9 @@
 #pragma once
-// A capsule run: drives a CapsuleSolver from its current state to t_end and keeps the run folder.
+// A run: drives a solver (capsule_solver.hpp) from its current state to t_end, keeps the run
+// folder (run_folder.hpp) and lets a recorder (run_recorder.hpp) record every accepted step. One
+// loop for every solver and every recorder: run_capsule() is the run of one capsule (its recorder
+// CapsuleRecorder, capsule_recorder.hpp); a suspension of many cells is a run with its own
+// recorder (flow/suspension_run.hpp). For a capsule the folder holds:
 //
 //   timeseries.csv   one row per accepted step (time_series.hpp), append-only, flushed per row
 //   snapshot_NNNNN.vtp + shapes.pvd   the shape every snapshot_every (and at t_end)
@@ -33,8 +37,10 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "bendlab/capsule/capsule_recorder.hpp"
 #include "bendlab/capsule/capsule_shape.hpp"
 #include "bendlab/capsule/capsule_solver.hpp"
+#include "bendlab/capsule/run_recorder.hpp"
 #include "bendlab/capsule/time_series.hpp"
 
 namespace bendlab {
@@ -42,7 +48,8 @@ namespace bendlab {
 struct CapsuleProgress {
   double time = 0, t_start = 0, t_end = 0;  ///< gamma t now, at the start of this part, at the end
   double dt = 0;                            ///< the last step
-  double D = 0, theta = 0;
+  double D = 0, theta = 0;                  ///< a capsule's (CapsuleRecorder); NaN for other recorders
+  ProgressMeasures measures;                ///< the recorder's figures of the last step
   std::int64_t steps = 0;                   ///< accepted steps of the whole run
   double elapsed_seconds = 0;               ///< wall time of this part
   double eta_seconds = 0;                   ///< estimated wall time to t_end
@@ -89,20 +96,16 @@ struct CapsuleRunResult {
   double wall_seconds = 0; ///< wall time of all parts of the run (timing.json; when finished)
 };
 
-/// The time-series row of positions x at time t after a step dt: D and theta of the equivalent
-/// ellipsoid (capsule_shape.hpp), volume, area, the membrane's energies, and the axis angle and
-/// node phase of `markers` (default: motion_markers of the membrane's initial positions), folded
-/// into their ranges (the run unwraps them).
-TimeSeriesRow capsule_sample(const MembraneModel& membrane, const Points& x, double t, double dt,
-                             const MotionMarkers* markers = nullptr);
+/// Runs `solver` as described above, `recorder` recording its steps. Throws bendlab::Error
+/// (before any file changes for bad options or a refused checkpoint).
+CapsuleRunResult run_solver(CapsuleSolver& solver, RunRecorder& recorder, const CapsuleRunOptions& options);
 
-/// Runs `solver` as described above. Throws bendlab::Error (before any file changes for bad
-/// options or a refused checkpoint).
+/// The run of one capsule: run_solver with a CapsuleRecorder of the solver's membrane.
 CapsuleRunResult run_capsule(CapsuleSolver& solver, const CapsuleRunOptions& options);
 
 /// Whether `name` is a file a capsule run writes into its folder (with `solver`'s side files), or
-/// a temporary the run can have made for one (core/atomic_file.hpp's atomic_temp_target, or a
-/// side file's "<name>.tmp"): the files --overwrite removes. Other names are never the run's.
+/// a temporary the run can have made for one (run_folder.hpp): the files --overwrite removes.
+/// Other names are never the run's.
 bool is_run_file(const std::string& name, const CapsuleSolver& solver);
 
 /// Whether two argument sets are equal (same keys; numbers to 1e-12 relative); otherwise the first

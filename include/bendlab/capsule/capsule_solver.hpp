@@ -1,7 +1,9 @@
 #pragma once
-// What a flow solver offers to a capsule run (capsule_run.hpp). The run owns the files (time
-// series, snapshots, checkpoint, summary) and the statistics; the solver owns the physics and
-// its own state. Two kinds fit behind it:
+// What a flow solver offers to a run (capsule_run.hpp). The run owns the files (snapshots,
+// checkpoint, summary) and its recorder (run_recorder.hpp) the time series and the statistics;
+// the solver owns the physics and its own state. A solver moves bodies: one capsule, or the many
+// cells of a suspension (flow/lbm/lbm_suspension_solver.hpp); positions() holds all their
+// vertices, body after body. Two kinds of capsule solver fit behind it:
 //  - the boundary integral method (flow/bim/bim_capsule_solver.hpp): node velocity = function of
 //    the positions, advanced by an adaptive Integrator; its extra state is the proposed next step;
 //  - a lattice Boltzmann solver: fixed steps, explicit Euler for the nodes, a fluid whose state
@@ -32,6 +34,13 @@ struct AcceptedStep {
   const Points* positions = nullptr;   ///< N x 3, valid during the callback only
 };
 
+/// A body a solver moves: its membrane (reference state, moduli, topology) and its rows of the
+/// solver's positions(): [first_row, first_row + membrane->num_vertices()).
+struct SolverBody {
+  const MembraneModel* membrane = nullptr;
+  Eigen::Index first_row = 0;
+};
+
 /// The solver-specific part of a checkpoint: JSON fields, plus side files the solver wrote into
 /// the run folder (names relative to it). The run deletes the side files of an older checkpoint
 /// once a newer checkpoint.json has been committed, so a solver must give its side files names
@@ -50,10 +59,13 @@ class CapsuleSolver {
   virtual ~CapsuleSolver() = default;
   /// "bim", "lbm", ...
   virtual std::string name() const = 0;
-  /// The membrane whose nodes the solver moves (reference state, moduli, energies).
+  /// The membrane whose nodes the solver moves (reference state, moduli, energies); a solver of
+  /// several bodies returns its first body's.
   virtual const MembraneModel& membrane() const = 0;
+  /// Every body, in the order of positions()' rows: a capsule solver's one membrane.
+  virtual std::vector<SolverBody> bodies() const { return {{&membrane(), 0}}; }
 
-  /// Current node positions (N x 3) and time (gamma t).
+  /// Current node positions (N x 3: every body's) and time (the run's unit: gamma t, or seconds).
   virtual const Points& positions() const = 0;
   virtual double time() const = 0;
 

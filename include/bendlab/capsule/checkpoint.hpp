@@ -7,7 +7,7 @@
 //    "solver": "bim", "time": t, "vertices": N, "positions": [3N numbers, row-major],
 //    "steps": accepted steps so far (= rows of timeseries.csv), "wall_seconds": w,
 //    "counters": {"rejected_steps", "velocity_evaluations"},
-//    "steady": SteadyStatistics::to_json(),
+//    "steady": SteadyStatistics::to_json(),   the recorder's keys (run_recorder.hpp; a capsule's)
 //    "snapshots": [[t, "snapshot_00000.vtp"], ...],
 //    "solver_state": {...}, "side_files": [...]}     (CapsuleSolver::save_state)
 //
@@ -22,7 +22,6 @@
 #include <vector>
 
 #include "bendlab/capsule/capsule_solver.hpp"
-#include "bendlab/capsule/steady_statistics.hpp"
 
 namespace bendlab {
 
@@ -36,7 +35,10 @@ struct CapsuleCheckpoint {
   std::int64_t steps = 0;
   double wall_seconds = 0;
   SolverCounters counters;
-  SteadyStatistics steady;
+  /// The run recorder's state (RunRecorder::state): top-level keys of the document beside the
+  /// checkpoint's own, validated by the recorder on resume. Reading keeps every key that is not
+  /// the checkpoint's own here.
+  nlohmann::json recorder = nlohmann::json::object();
   std::vector<std::pair<double, std::string>> snapshots;
   SolverState solver_state;
 
