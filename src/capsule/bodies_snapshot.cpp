@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include "bendlab/core/atomic_file.hpp"
 #include "bendlab/mesh/mesh_io.hpp"
 
 namespace bendlab {
@@ -9,6 +10,16 @@ namespace bendlab {
 void write_bodies_snapshot(const std::filesystem::path& path, const std::vector<SolverBody>& bodies, const Points& x) {
   if (bodies.size() == 1 && bodies.front().first_row == 0 && bodies.front().membrane->num_vertices() == x.rows()) {
     write_mesh(path, bodies.front().membrane->topology(), x);
+    return;
+  }
+  if (bodies.empty()) {
+    // No body (a flow without cells): an empty piece, which ParaView shows as nothing.
+    if (x.rows() != 0) throw Error(fmt::format("snapshot '{}': {} positions for no body", path.string(), x.rows()));
+    AtomicFile f(path);
+    f.stream() << "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
+                  "  <PolyData>\n    <Piece NumberOfPoints=\"0\" NumberOfVerts=\"0\" NumberOfLines=\"0\" "
+                  "NumberOfStrips=\"0\" NumberOfPolys=\"0\">\n    </Piece>\n  </PolyData>\n</VTKFile>\n";
+    f.commit();
     return;
   }
   Eigen::Index faces = 0, rows = 0;

@@ -4,8 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <regex>
 
+#include "bendlab/flow/lbm/fluid_state.hpp"
 #include "bendlab/geometry/measures.hpp"
 
 namespace bendlab {
@@ -91,20 +91,15 @@ bool IbCapsuleSolver::advance(double t_end, const OnStep& on_step) {
   return true;
 }
 
-bool IbCapsuleSolver::is_side_file(const std::string& name) const {
-  static const std::regex fluid_re(R"(lbm_fluid_\d{5,}\.bin)");
-  return std::regex_match(name, fluid_re);
-}
+bool IbCapsuleSolver::is_side_file(const std::string& name) const { return lbm::is_fluid_file(name); }
 
 SolverState IbCapsuleSolver::save_state(const std::filesystem::path& folder, const std::string& tag) const {
   check_fluid();  // never checkpoint a broken fluid
   SolverState s;
-  const std::string fluid = fmt::format("lbm_fluid_{}.bin", tag);
+  const std::string fluid = lbm::fluid_file_name(tag);
   write_fluid(folder / fluid);
   s.side_files.push_back(fluid);
-  s.fields = {{"fluid", fluid},
-              {"lattice_step", fluid_step_count()},
-              {"positions_lattice", std::vector<double>(X_.data(), X_.data() + X_.size())}};
+  s.fields = lbm::fluid_state_fields(fluid, fluid_step_count(), X_);
   return s;
 }
 
@@ -112,23 +107,9 @@ void IbCapsuleSolver::restore_state(const Points& positions, double time, const 
                                     const nlohmann::json& fields, const std::filesystem::path& folder,
                                     const std::string& source) {
   auto bad = [&](const std::string& what) { return Error(fmt::format("{}: \"solver_state\": {}", source, what)); };
-  if (!fields.is_object()) throw bad("must be an object");
-  if (!fields.contains("fluid") || !fields.at("fluid").is_string()) throw bad("\"fluid\" must name the fluid file");
-  if (!is_side_file(fields.at("fluid").get<std::string>()))
-    throw bad(fmt::format("\"fluid\" is {}, expected lbm_fluid_NNNNN.bin", fields.at("fluid").dump()));
-  if (!fields.contains("lattice_step") || !fields.at("lattice_step").is_number_integer() ||
-      fields.at("lattice_step").get<std::int64_t>() < 0)
-    throw bad("\"lattice_step\" must be an integer >= 0");
-  const std::int64_t n = fields.at("lattice_step").get<std::int64_t>();
-  if (!fields.contains("positions_lattice") || !fields.at("positions_lattice").is_array() ||
-      fields.at("positions_lattice").size() != static_cast<std::size_t>(X_.size()))
-    throw bad(fmt::format("\"positions_lattice\" must hold {} numbers", X_.size()));
-  Points X(X_.rows(), 3);
-  for (Eigen::Index i = 0; i < X.size(); ++i) {
-    const auto& v = fields.at("positions_lattice")[static_cast<std::size_t>(i)];
-    if (!v.is_number() || !std::isfinite(v.get<double>())) throw bad("\"positions_lattice\" has a non-finite entry");
-    X.data()[i] = v.get<double>();
-  }
+  const lbm::FluidStateFields saved = lbm::parse_fluid_state(fields, X_.rows(), source);
+  const std::int64_t n = saved.lattice_step;
+  const Points& X = saved.X;
   const double t = static_cast<double>(n) * gamma_;
   if (std::abs(t - time) > 1e-9 * std::max(1.0, std::abs(time)))
     throw bad(fmt::format("\"lattice_step\" {} is gamma t = {}, the checkpoint's time is {}", n, t, time));
@@ -136,7 +117,7 @@ void IbCapsuleSolver::restore_state(const Points& positions, double time, const 
     throw bad("\"positions_lattice\" do not match the checkpoint's positions");
   std::int64_t file_step = 0;
   try {
-    file_step = read_fluid(folder / fields.at("fluid").get<std::string>(), n);
+    file_step = read_fluid(folder / saved.fluid, n);
   } catch (const Error& e) {
     throw Error(fmt::format("{}: {}", source, e.what()));
   }

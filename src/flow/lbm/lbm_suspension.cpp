@@ -42,6 +42,16 @@ int LbmSuspension::add_cell(std::shared_ptr<const MembraneModel> membrane, const
   return c;
 }
 
+void LbmSuspension::restore(Lattice lattice, const Points& X) {
+  const LatticeConfig& a = lattice.config();
+  const LatticeConfig& b = lattice_.config();
+  if (a.nx != b.nx || a.ny != b.ny || a.nz != b.nz) throw Error("suspension: the restored lattice has another size");
+  if (X.rows() != X_.rows() || !X.allFinite())
+    throw Error(fmt::format("suspension: {} restored positions for {} vertices", X.rows(), X_.rows()));
+  lattice_ = std::move(lattice);
+  X_ = X;
+}
+
 void LbmSuspension::step() {
   const std::int64_t n = lattice_.step_count() + 1;
   try {

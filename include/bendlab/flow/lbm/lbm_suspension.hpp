@@ -52,6 +52,10 @@ class LbmSuspension {
     for (std::int64_t s = 0; s < steps; ++s) step();
   }
 
+  /// Replaces the fluid and every vertex by a checkpoint's: `lattice` of this configuration, X of
+  /// positions()' rows (lattice units). Throws bendlab::Error for a mismatch.
+  void restore(Lattice lattice, const Points& X);
+
   int num_cells() const { return static_cast<int>(cells_.size()); }
   /// Rows of cell c in positions(): [first_row(c), first_row(c) + rows(c)).
   Eigen::Index first_row(int c) const { return cells_[c].first; }

@@ -1,0 +1,166 @@
+// bendlab flow: red blood cells (or other cell kinds) in a tube or a slit channel, periodic along
+// the flow, on the lattice Boltzmann solver with the immersed boundary, in physical units
+// (shared/spec/CELLS_IN_CHANNELS.md; docs/conventions.md §6). Argument parsing only: the run is
+// FlowRun (bendlab/flow/flow_run.hpp), whose folder belongs to the one run loop
+// (bendlab/capsule/capsule_run.hpp) with the suspension's recorder
+// (bendlab/flow/suspension_recorder.hpp).
+#include <fmt/format.h>
+
+#include <iostream>
+#include <optional>
+
+#include "bendlab/flow/flow_run.hpp"
+#include "command.hpp"
+#include "method_cli.hpp"
+
+namespace bendlab::cli {
+namespace {
+
+struct FlowArgs {
+  std::string geometry = "tube", out;
+  std::optional<double> diameter, height, width, pseudo_shear_rate, body_force, hematocrit;
+  std::optional<int> cells;
+  double length = 0;
+  double contact_force_pn = 0;
+  double t_end = 0.01, snapshot_every = 0.001;
+  std::vector<std::string> options;
+  std::int64_t stop_after_steps = 0;
+  bool resume = false, overwrite = false;
+  FlowRunSpec spec;
+};
+
+void flow(FlowArgs& a) {
+  FlowRunSpec& s = a.spec;
+  const bool tube = a.geometry == "tube";
+  s.units.geometry = tube ? lbm::FlowGeometry::Tube : lbm::FlowGeometry::Channel;
+  if (tube) {
+    if (!a.diameter) throw Error("--diameter (um) is required for --geometry tube");
+    if (a.height || a.width) throw Error("--height and --width are for --geometry channel (a tube takes --diameter)");
+    s.units.diameter_um = *a.diameter;
+  } else {
+    if (!a.height || !a.width) throw Error("--height and --width (um) are required for --geometry channel");
+    if (a.diameter) throw Error("--diameter is for --geometry tube (a channel takes --height and --width)");
+    s.units.height_um = *a.height;
+    s.units.width_um = *a.width;
+  }
+  if (!(a.length > 0)) throw Error("--length (um, the periodic extent along the flow) is required and positive");
+  s.units.length_um = a.length;
+  s.units.pseudo_shear_rate = a.pseudo_shear_rate;
+  s.units.body_force = a.body_force;
+  s.hematocrit = a.hematocrit;
+  s.cells = a.cells;
+  if (!a.hematocrit && !a.cells) throw Error("give --hematocrit (tube hematocrit, 0: plain Poiseuille flow) or --cells");
+  if (!(a.contact_force_pn >= 0) || !std::isfinite(a.contact_force_pn))
+    throw Error(fmt::format("--contact-force {} pN must be >= 0 (0: the default G_s dx)", a.contact_force_pn));
+  s.contact_force = a.contact_force_pn * 1e-12;
+  s.cell.method_options = a.options;
+  if (!(a.t_end > 0) || !std::isfinite(a.t_end)) throw Error(fmt::format("--t-end {} s must be positive", a.t_end));
+
+  FlowRun run(s, note);
+  for (const std::string& line : run.describe()) note(line);
+  if (const auto w = run.warning()) note("warning: " + *w);
+  CapsuleRunOptions o;
+  o.folder = a.out;
+  o.t_end = a.t_end;
+  o.snapshot_every = a.snapshot_every;
+  o.resume = a.resume;
+  o.overwrite = a.overwrite;
+  o.stop_after_steps = a.stop_after_steps;
+  o.on_note = note;
+  const double dt = run.units().dt;
+  const double nodes = static_cast<double>(run.solver().suspension().lattice().num_fluid_nodes());
+  o.on_progress = [dt, nodes](const CapsuleProgress& p) {
+    std::string measures;
+    for (const auto& [name, value] : p.measures) measures += fmt::format("  {} {:.4g}", name, value);
+    const double steps = (p.time - p.t_start) / dt;
+    note(fmt::format("t = {:.4g} / {:g} s ({:3.0f}%){}  elapsed {:.0f} s  ETA {:.0f} s  {:.1f} MLUPS", p.time, p.t_end,
+                     100 * (p.time - p.t_start) / (p.t_end - p.t_start), measures, p.elapsed_seconds, p.eta_seconds,
+                     p.elapsed_seconds > 0 ? steps * nodes / p.elapsed_seconds * 1e-6 : 0.0));
+  };
+  const CapsuleRunResult result = run.run(o);
+  if (!result.finished) {
+    note(fmt::format("stopped after {} reports; continue with --resume", a.stop_after_steps));
+    return;
+  }
+  std::cout << result.summary.dump() << std::endl;
+}
+
+const CommandRegistration registration([](CLI::App& app) {
+  auto args = std::make_shared<FlowArgs>();
+  FlowRunSpec& s = args->spec;
+  auto* cmd = app.add_subcommand(
+      "flow", "Simulate cells (red blood cells by default) in a tube or a slit channel, periodic along the flow, "
+              "with the immersed-boundary lattice Boltzmann method in physical units: apparent viscosity, "
+              "hematocrits, cell-free layer, profiles");
+  cmd->add_option("--geometry", args->geometry, "tube (a circular tube) or channel (plane walls at z = -+H/2, "
+                                                "periodic in y over --width)")
+      ->check(CLI::IsMember({"tube", "channel"}))->capture_default_str();
+  cmd->add_option("--diameter", args->diameter, "tube diameter D, um (whole dx not needed: the wall is interpolated)");
+  cmd->add_option("--height", args->height, "channel height H (wall distance), um, a whole number of dx");
+  cmd->add_option("--width", args->width, "channel width (periodic, across the flow), um, a whole number of dx");
+  cmd->add_option("--length", args->length, "periodic length along the flow, um, a whole number of dx")->required();
+  cmd->add_option("--dx", s.units.dx_um, "lattice spacing, um")->capture_default_str();
+  cmd->add_option("--tau", s.units.tau, "LBM relaxation time, > 1/2: sets dt = (tau - 1/2) dx^2 / (3 nu)")
+      ->capture_default_str();
+  auto* rate = cmd->add_option("--pseudo-shear-rate", args->pseudo_shear_rate,
+                               "driving as the pseudo-shear rate v / D (v / H) of the cell-free flow, 1/s (v its "
+                               "mean velocity, Pries' measure)");
+  auto* force = cmd->add_option("--body-force", args->body_force, "driving as a body force density along x, N/m^3");
+  rate->excludes(force);
+  cmd->add_option("--plasma-viscosity", s.units.plasma.viscosity, "Pa s")->capture_default_str();
+  cmd->add_option("--plasma-density", s.units.plasma.density, "kg/m^3")->capture_default_str();
+  auto* hct = cmd->add_option("--hematocrit", args->hematocrit,
+                              "target tube hematocrit H_T in [0, 1) (0: plain Poiseuille flow); placement reports "
+                              "what it reached and refuses what it cannot place");
+  auto* count = cmd->add_option("--cells", args->cells, "a number of cells instead of --hematocrit");
+  hct->excludes(count);
+  cmd->add_option("--seed", s.seed, "placement seed")->capture_default_str();
+  cmd->add_option("--cell", s.cell.shape, "cell kind: rbc (eq. (15) of the paper) or sphere")
+      ->check(CLI::IsMember({"rbc", "sphere"}))->capture_default_str();
+  cmd->add_option("--cell-radius", s.cell.radius_um, "cell radius R, um (rbc: the large half-axis)")
+      ->capture_default_str();
+  cmd->add_option("--mesh", s.cell.mesh, "cell mesh: mt1:N or mt2:N (N triangles) or a mesh file")
+      ->capture_default_str();
+  cmd->add_option("--method", s.cell.method, "bending method: " + method_names_joined())
+      ->check(CLI::IsMember(method_choices_with_none()))->capture_default_str();
+  cmd->add_option("--option", args->options, "method option key=value, repeatable (bendlab methods)");
+  cmd->add_option("--membrane", s.cell.elastic_law, "in-plane elastic law: skalak or neo-hookean")
+      ->check(CLI::IsMember({"skalak", "neo-hookean"}))->capture_default_str();
+  cmd->add_option("--shear-modulus", s.cell.shear_modulus, "membrane shear modulus G_s, N/m")->capture_default_str();
+  cmd->add_option("--skalak-c", s.cell.skalak_c, "the Skalak law's C (area modulus G_s (1 + 2C))")
+      ->capture_default_str();
+  cmd->add_option("--bending-modulus", s.cell.bending_modulus, "bending modulus kappa_B, J")->capture_default_str();
+  cmd->add_option("--volume-ratio", s.cell.volume_modulus_ratio,
+                  "kappa_V / kappa_S of the volume force (0: none)")->capture_default_str();
+  cmd->add_option("--contact-cutoff", s.contact_cutoff_um,
+                  "repulsion cutoff between cells and at walls, um (0: one dx)")->capture_default_str();
+  cmd->add_option("--contact-force", args->contact_force_pn,
+                  "repulsion force at contact, pN (0: G_s dx, the membrane tension over one dx)")
+      ->capture_default_str();
+  cmd->add_option("--t-end", args->t_end, "end of the run, s")->capture_default_str();
+  cmd->add_option("--sample-every", s.sample_every, "s between time-series rows (whole lattice steps)")
+      ->capture_default_str();
+  cmd->add_option("--snapshot-every", args->snapshot_every, "s between .vtp snapshots of all cells and checkpoints")
+      ->capture_default_str();
+  cmd->add_option("--steady-from", s.steady_from,
+                  "the steady window of the summary's means starts at this fraction of --t-end")
+      ->capture_default_str();
+  cmd->add_option("--slice-width", s.slice_width_um, "slices along x of the cell-free layer, um")
+      ->capture_default_str();
+  auto* resume = cmd->add_flag("--resume", args->resume,
+                               "continue the run in --out from its last checkpoint (--t-end later than the "
+                               "checkpoint's, or equal to complete a run stopped before its summary)");
+  cmd->add_flag("--overwrite", args->overwrite,
+                "start a new run in an --out that holds another run, removing that run's files")
+      ->excludes(resume);
+  cmd->add_option("--stop-after-steps", args->stop_after_steps,
+                  "stop after this many time-series rows (no summary; continue with --resume)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--out", args->out,
+                  "output folder (created if missing; its parent must exist); locked while the run owns it")
+      ->required();
+  cmd->callback([args] { flow(*args); });
+});
+
+}  // namespace
+}  // namespace bendlab::cli

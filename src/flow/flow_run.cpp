@@ -1,0 +1,218 @@
+#include "bendlab/flow/flow_run.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace bendlab {
+
+double lattice_flow_rate(const lbm::Lattice& lattice, double dx_um, double dt_seconds) {
+  // The same order of sums as the recorder's (suspension_recorder.cpp): line by line along x.
+  double flux = 0;
+  const int nx = lattice.nx();
+  for (int k = 0; k < lattice.nz(); ++k)
+    for (int j = 0; j < lattice.ny(); ++j) {
+      if (lattice.solid_row(j, k)) continue;
+      double line = 0;
+      for (int i = 0; i < nx; ++i) line += lattice.velocity(lattice.index(i, j, k)).x();
+      flux += line;
+    }
+  return flux / nx * dx_um * dx_um * dx_um / dt_seconds;
+}
+
+nlohmann::json FlowRunSpec::to_json() const {
+  const lbm::FlowUnitsInput& u = units;
+  const bool tube = u.geometry == lbm::FlowGeometry::Tube;
+  nlohmann::json j = {{"geometry", lbm::to_string(u.geometry)},
+                      {"length_um", u.length_um},
+                      {"dx_um", u.dx_um},
+                      {"tau", u.tau},
+                      {"plasma_viscosity", u.plasma.viscosity},
+                      {"plasma_density", u.plasma.density},
+                      {"cell", cell.shape},
+                      {"cell_radius_um", cell.radius_um},
+                      {"mesh", cell.mesh},
+                      {"elastic_law", cell.elastic_law},
+                      {"shear_modulus", cell.shear_modulus},
+                      {"skalak_c", cell.skalak_c},
+                      {"bending_modulus", cell.bending_modulus},
+                      {"method", cell.method},
+                      {"method_options", cell.method_options},
+                      {"volume_modulus_ratio", cell.volume_modulus_ratio},
+                      {"seed", seed},
+                      {"contact_cutoff_um", contact_cutoff_um},
+                      {"contact_force", contact_force},
+                      {"sample_every", sample_every},
+                      {"steady_from", steady_from},
+                      {"slice_width_um", slice_width_um}};
+  if (tube) {
+    j["diameter_um"] = u.diameter_um;
+  } else {
+    j["height_um"] = u.height_um;
+    j["width_um"] = u.width_um;
+  }
+  if (u.pseudo_shear_rate) j["pseudo_shear_rate"] = *u.pseudo_shear_rate;
+  if (u.body_force) j["body_force"] = *u.body_force;
+  if (hematocrit) j["hematocrit"] = *hematocrit;
+  if (cells) j["cells"] = *cells;
+  return j;
+}
+
+namespace {
+
+const FlowRunSpec& checked(const FlowRunSpec& s) {
+  if (s.hematocrit && s.cells) throw Error("give --hematocrit or --cells, not both");
+  if (s.hematocrit && (!std::isfinite(*s.hematocrit) || *s.hematocrit < 0 || *s.hematocrit >= 1))
+    throw Error(fmt::format("--hematocrit {} must lie in [0, 1)", *s.hematocrit));
+  if (s.cells && *s.cells < 0) throw Error(fmt::format("--cells {} must be >= 0", *s.cells));
+  if (!(s.contact_cutoff_um >= 0) || !std::isfinite(s.contact_cutoff_um))
+    throw Error(fmt::format("--contact-cutoff {} um must be >= 0 (0: one dx)", s.contact_cutoff_um));
+  if (!(s.contact_force >= 0) || !std::isfinite(s.contact_force))
+    throw Error(fmt::format("--contact-force {} N must be >= 0 (0: G_s dx)", s.contact_force));
+  if (!(s.sample_every > 0) || !std::isfinite(s.sample_every))
+    throw Error(fmt::format("--sample-every {} s must be positive", s.sample_every));
+  if (!(s.steady_from >= 0 && s.steady_from < 1))
+    throw Error(fmt::format("--steady-from {} must lie in [0, 1)", s.steady_from));
+  if (!(s.slice_width_um > 0) || !std::isfinite(s.slice_width_um))
+    throw Error(fmt::format("--slice-width {} um must be positive", s.slice_width_um));
+  return s;
+}
+
+Vessel vessel_of(const lbm::FlowUnitsInput& u, double scale) {
+  if (u.geometry == lbm::FlowGeometry::Tube) return Vessel::tube(u.diameter_um * scale, u.length_um * scale);
+  return Vessel::channel(u.height_um * scale, u.width_um * scale, u.length_um * scale);
+}
+
+}  // namespace
+
+FlowRun::FlowRun(const FlowRunSpec& spec, const std::function<void(const std::string&)>& note)
+    : spec_(checked(spec)), units_(lbm::flow_units(spec_.units)), kind_(make_cell_kind(spec_.cell)) {
+  auto say = [&](const std::string& s) {
+    if (note) note(s);
+  };
+  const double dx = spec_.units.dx_um;
+  vessel_um_ = vessel_of(spec_.units, 1.0);
+  const double cutoff_um = spec_.contact_cutoff_um > 0 ? spec_.contact_cutoff_um : dx;
+  const double contact_force = spec_.contact_force > 0 ? spec_.contact_force : spec_.cell.shear_modulus * dx * 1e-6;
+
+  // The cells, placed in um.
+  const bool any_cells = (spec_.hematocrit && *spec_.hematocrit > 0) || (spec_.cells && *spec_.cells > 0);
+  if (any_cells) {
+    // An undeformed cell must fit the section to be placed: a tube takes a body of revolution
+    // whose second largest extent (a disc's diameter, a prolate's width) is below D, a channel
+    // one whose smallest extent is below H. The reference shape's axes are the frame's.
+    const Points& ref = kind_.reference_um.positions();
+    Vec3 extent = ref.colwise().maxCoeff() - ref.colwise().minCoeff();
+    std::sort(extent.data(), extent.data() + 3);
+    const bool tube_geometry = spec_.units.geometry == lbm::FlowGeometry::Tube;
+    const double needed = tube_geometry ? extent[1] : extent[0];
+    const double section = tube_geometry ? spec_.units.diameter_um : spec_.units.height_um;
+    if (needed + 2 * 0.5 * cutoff_um >= section)
+      throw Error(fmt::format("{} {} um is narrower than the cell: a {} of {} um across at best (its wall clearance "
+                              "included) cannot be placed undeformed",
+                              tube_geometry ? "--diameter" : "--height", section, spec_.cell.shape,
+                              needed + cutoff_um));
+    PlacementOptions p;
+    p.hematocrit = spec_.hematocrit;
+    p.count = spec_.cells;
+    // Half the repulsion's cutoff: a quarter of the contact force at most as the run starts, and
+    // room to place H_T 0.3 in a 10 um tube.
+    p.clearance = 0.5 * cutoff_um;
+    p.seed = spec_.seed;
+    placement_ = place_cells(vessel_um_, *kind_.reference_um.topology_ptr(), kind_.reference_um.positions(), p);
+    say(fmt::format("placed {} cells at tube hematocrit {:.4g} (seed {}, {} attempts)", placement_.cells.size(),
+                    placement_.hematocrit, spec_.seed, placement_.attempts));
+  }
+
+  SuspensionSolverOptions o;
+  o.suspension.lattice = lbm::flow_lattice_config(units_);
+  o.suspension.vessel = vessel_of(spec_.units, 1.0 / dx);
+  const double force_lattice = units_.to_lattice_force(contact_force);
+  o.suspension.cell_contact = ContactLaw{force_lattice, cutoff_um / dx};
+  o.suspension.wall_contact = ContactLaw{force_lattice, cutoff_um / dx};
+  o.dx_um = dx;
+  o.dt_seconds = units_.dt;
+  o.sample_every = spec_.sample_every;
+  solver_ = std::make_unique<LbmSuspensionSolver>(o);
+
+  // The cell-free flow from the analytic Poiseuille profile, relaxed on the lattice.
+  lbm::Lattice& lattice = solver_->suspension().lattice();
+  const bool tube = spec_.units.geometry == lbm::FlowGeometry::Tube;
+  const double half = 0.5 * units_.section_lattice;  // R or H / 2 in dx
+  const double v = units_.to_lattice_velocity(units_.mean_velocity);
+  const double peak = tube ? 2 * v : 1.5 * v;
+  lattice.initialise(
+      [&](const Vec3& p) {
+        const double s = tube ? (p.y() * p.y() + p.z() * p.z()) / (half * half) : p.z() * p.z() / (half * half);
+        return Vec3(s < 1 ? peak * (1 - s) : 0.0, 0, 0);
+      },
+      nullptr,
+      [&](const Vec3& p) {
+        Mat3 S = Mat3::Zero();
+        const double s = tube ? (p.y() * p.y() + p.z() * p.z()) / (half * half) : p.z() * p.z() / (half * half);
+        if (s < 1) {
+          if (tube) S(1, 0) = -2 * peak * p.y() / (half * half);
+          S(2, 0) = -2 * peak * p.z() / (half * half);
+        }
+        return S;
+      });
+  double q = lattice_flow_rate(lattice, dx, units_.dt);
+  constexpr std::int64_t kBlock = 100;
+  while (relax_steps_ < kMaxRelaxSteps) {
+    lattice.run(kBlock);
+    relax_steps_ += kBlock;
+    const double next = lattice_flow_rate(lattice, dx, units_.dt);
+    const bool settled = std::abs(next - q) <= 1e-9 * std::abs(next);
+    q = next;
+    if (settled) break;
+  }
+  if (!(q > 0) || !std::isfinite(q))
+    throw Error(fmt::format("the cell-free flow's rate is {} after {} steps: the lattice cannot carry this flow", q,
+                            relax_steps_));
+  q0_ = q;
+  say(fmt::format("cell-free flow relaxed in {} steps: Q0 = {:.6g} um^3/s (mean velocity {:.4g} um/s, analytic {:.4g})",
+                  relax_steps_, q0_, q0_ / (vessel_um_.volume() / vessel_um_.length()), units_.mean_velocity * 1e6));
+  // The run starts at step 0 from the relaxed flow (the relaxation took a multiple of 100 steps,
+  // so the populations are in the AA layout of an even step, as at step 0).
+  lattice.restore_raw(lattice.raw_populations(), 0);
+
+  const std::shared_ptr<const MembraneModel> membrane = lattice_membrane(kind_, units_);
+  for (const PlacedCell& c : placement_.cells)
+    solver_->add_cell(membrane, placed_positions(kind_.reference_um.positions(), c));
+}
+
+std::vector<std::string> FlowRun::describe() const {
+  std::vector<std::string> lines = units_.describe();
+  const double R = spec_.cell.radius_um * 1e-6;
+  // The capillary number of the cells: eta v R / (G_s D), v / D the pseudo-shear rate.
+  const double ca = spec_.units.plasma.viscosity * units_.pseudo_shear_rate * R / spec_.cell.shear_modulus;
+  lines.push_back(fmt::format("cells: {} x {} ({}, {}; G_s = {:.3g} N/m, kappa_B = {:.3g} J, Method {}), "
+                              "tube hematocrit {:.4g}; capillary number eta (v/D) R / G_s = {:.3g}",
+                              placement_.cells.size(), spec_.cell.shape, spec_.cell.mesh, spec_.cell.elastic_law,
+                              spec_.cell.shear_modulus, spec_.cell.bending_modulus, spec_.cell.method,
+                              placement_.hematocrit, ca));
+  return lines;
+}
+
+std::optional<std::string> FlowRun::warning() const { return mesh_leak_warning(kind_, spec_.units.dx_um); }
+
+CapsuleRunResult FlowRun::run(CapsuleRunOptions options) {
+  nlohmann::json arguments = spec_.to_json();
+  for (const auto& [key, value] : options.arguments.items()) arguments[key] = value;
+  options.arguments = arguments;
+  options.summary_fields["achieved_hematocrit_placed"] = placement_.hematocrit;
+  options.summary_fields["relax_steps"] = relax_steps_;
+  options.summary_fields["dt_s"] = units_.dt;
+  options.summary_fields["mach"] = units_.mach;
+  options.summary_fields["reynolds"] = units_.reynolds;
+  SuspensionRecorderOptions r;
+  r.vessel_um = vessel_um_;
+  r.reference_flow_rate = q0_;
+  r.slice_width_um = spec_.slice_width_um;
+  r.steady_from = spec_.steady_from;
+  SuspensionRecorder recorder(*solver_, r);
+  return run_solver(*solver_, recorder, options);
+}
+
+}  // namespace bendlab
