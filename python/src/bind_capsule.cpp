@@ -12,12 +12,11 @@
 #include "bendlab/core/file_input.hpp"
 #include "bendlab/flow/shear_run.hpp"
 #include "bindings.hpp"
+#include "run_hooks.hpp"
 
 namespace bendlab::python {
 
 namespace {
-
-py::object json_to_python(const nlohmann::json& j) { return py::module_::import("json").attr("loads")(j.dump()); }
 
 std::string option_value(const py::handle& v) {
   if (py::isinstance<py::bool_>(v)) return v.cast<bool>() ? "true" : "false";
@@ -61,36 +60,17 @@ void bind_capsule(py::module_& m) {
         spec.overwrite = overwrite;
         spec.stop_after_steps = stop_after_steps;
 
-        // Python errors raised in a callback, or Ctrl-C, stop the run at the next accepted step
-        // (resumable from its last checkpoint) and are raised again here.
-        std::optional<py::error_already_set> pending;
+        RunHooks hooks(progress);
         ShearRunCallbacks cb;
         cb.progress_interval_seconds = progress_interval;
-        cb.should_stop = [&pending]() {
-          py::gil_scoped_acquire gil;
-          if (!pending && PyErr_CheckSignals() != 0) pending.emplace();
-          return pending.has_value();
-        };
-        if (!progress.is_none()) {
-          cb.on_progress = [&pending, &progress](const CapsuleProgress& p) {
-            py::gil_scoped_acquire gil;
-            if (pending) return;
-            try {
-              progress(py::dict(py::arg("time") = p.time, py::arg("t_end") = p.t_end, py::arg("dt") = p.dt,
-                                py::arg("D") = p.D, py::arg("theta") = p.theta, py::arg("steps") = p.steps,
-                                py::arg("elapsed_seconds") = p.elapsed_seconds, py::arg("eta_seconds") = p.eta_seconds,
-                                py::arg("final") = p.final));
-            } catch (py::error_already_set& e) {
-              pending.emplace(std::move(e));
-            }
-          };
-        }
+        cb.should_stop = hooks.should_stop();
+        cb.on_progress = hooks.on_progress();
         CapsuleRunResult result;
         {
           py::gil_scoped_release release;
           result = run_shear(spec, cb);
         }
-        if (pending) throw std::move(*pending);
+        hooks.rethrow();
         if (!result.finished) return py::none();
         return json_to_python(result.summary);
       },

@@ -8,5 +8,6 @@ void bind_mesh(pybind11::module_& m);
 void bind_bending(pybind11::module_& m);
 void bind_surfaces(pybind11::module_& m);
 void bind_capsule(pybind11::module_& m);
+void bind_flow(pybind11::module_& m);
 
 }  // namespace bendlab::python

@@ -24,4 +24,5 @@ PYBIND11_MODULE(_bendlab, m) {
   bendlab::python::bind_surfaces(m);
   bendlab::python::bind_bending(m);
   bendlab::python::bind_capsule(m);
+  bendlab::python::bind_flow(m);
 }
