@@ -7,20 +7,6 @@
 
 namespace bendlab {
 
-double lattice_flow_rate(const lbm::Lattice& lattice, double dx_um, double dt_seconds) {
-  // The same order of sums as the recorder's (suspension_recorder.cpp): line by line along x.
-  double flux = 0;
-  const int nx = lattice.nx();
-  for (int k = 0; k < lattice.nz(); ++k)
-    for (int j = 0; j < lattice.ny(); ++j) {
-      if (lattice.solid_row(j, k)) continue;
-      double line = 0;
-      for (int i = 0; i < nx; ++i) line += lattice.velocity(lattice.index(i, j, k)).x();
-      flux += line;
-    }
-  return flux / nx * dx_um * dx_um * dx_um / dt_seconds;
-}
-
 nlohmann::json FlowRunSpec::to_json() const {
   const lbm::FlowUnitsInput& u = units;
   const bool tube = u.geometry == lbm::FlowGeometry::Tube;

@@ -44,7 +44,30 @@ std::vector<double> json_numbers(const nlohmann::json& j, std::size_t n, const s
   return v;
 }
 
+// Visits every line of fluid nodes along x, (j, k) in index order, with the sum of u_x along it;
+// returns the sum over all lines. The flow rate and the velocity profile share it, so that Q0 of
+// the cell-free flow and Q of a run without cells are summed alike, bit for bit.
+template <class Visit>
+double sum_lines(const lbm::Lattice& lattice, Visit&& visit) {
+  double flux = 0;
+  const int nx = lattice.nx();
+  for (int k = 0; k < lattice.nz(); ++k)
+    for (int j = 0; j < lattice.ny(); ++j) {
+      if (lattice.solid_row(j, k)) continue;
+      double line = 0;
+      for (int i = 0; i < nx; ++i) line += lattice.velocity(lattice.index(i, j, k)).x();
+      flux += line;
+      visit(j, k, line);
+    }
+  return flux;
+}
+
 }  // namespace
+
+double lattice_flow_rate(const lbm::Lattice& lattice, double dx_um, double dt_seconds) {
+  const double flux = sum_lines(lattice, [](int, int, double) {});
+  return flux / lattice.nx() * dx_um * dx_um * dx_um / dt_seconds;
+}
 
 MeanWithError mean_with_error(const std::vector<double>& values) {
   MeanWithError m;
@@ -178,18 +201,12 @@ void SuspensionRecorder::record(const AcceptedStep& s) {
   const bool in_window = s.time >= options_.steady_from * t_end_ - 1e-12;
 
   // The flow rate, and the velocity profile in the window.
-  double flux = 0;
   const int nx = lattice.nx();
-  for (int k = 0; k < lattice.nz(); ++k)
-    for (int j = 0; j < lattice.ny(); ++j) {
-      if (lattice.solid_row(j, k)) continue;
-      double line = 0;
-      for (int i = 0; i < nx; ++i) line += lattice.velocity(lattice.index(i, j, k)).x();
-      flux += line;
-      const int bin = bin_of_line_[static_cast<std::size_t>(j) + static_cast<std::size_t>(lattice.ny()) * k];
-      if (in_window && bin >= 0) velocity_sum_[static_cast<std::size_t>(bin)] += line / nx * dx / dt;
-    }
-  const double Q = flux / nx * dx * dx * dx / dt;  // um^3/s
+  const double flux = sum_lines(lattice, [&](int j, int k, double line) {
+    const int bin = bin_of_line_[static_cast<std::size_t>(j) + static_cast<std::size_t>(lattice.ny()) * k];
+    if (in_window && bin >= 0) velocity_sum_[static_cast<std::size_t>(bin)] += line / nx * dx / dt;
+  });
+  const double Q = flux / nx * dx * dx * dx / dt;  // um^3/s, as lattice_flow_rate
   const Vessel& v = options_.vessel_um;
   const double area = v.volume() / v.length();
 

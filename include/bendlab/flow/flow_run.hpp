@@ -85,7 +85,4 @@ class FlowRun {
   std::unique_ptr<LbmSuspensionSolver> solver_;
 };
 
-/// Q of a lattice in um^3/s: the fluid nodes' u_x summed over the period (suspension_recorder.hpp).
-double lattice_flow_rate(const lbm::Lattice& lattice, double dx_um, double dt_seconds);
-
 }  // namespace bendlab

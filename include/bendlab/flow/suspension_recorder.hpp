@@ -44,6 +44,10 @@ struct SuspensionRecorderOptions {
   double steady_from = 0.5;                 ///< the steady window starts at steady_from t_end
 };
 
+/// Q of a lattice in um^3/s: the fluid nodes' u_x summed and divided by the period, as the
+/// recorder's flow rate.
+double lattice_flow_rate(const lbm::Lattice& lattice, double dx_um, double dt_seconds);
+
 /// Mean and standard error of `values` (batch means as above); NaN for no values.
 struct MeanWithError {
   double mean = 0, standard_error = 0;
