@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <regex>
 
 #include "bendlab/capsule/capsule_shape.hpp"
 #include "bendlab/capsule/checkpoint.hpp"
@@ -139,7 +140,32 @@ SuspensionRecorder::SuspensionRecorder(const LbmSuspensionSolver& solver, Suspen
 }
 
 bool SuspensionRecorder::is_output(const std::string& name) const {
-  return name == kSeries || name == kCells || name == kProfiles;
+  static const std::regex slice_re(R"(fluid_\d{5,}\.vtk)");
+  return name == kSeries || name == kCells || name == kProfiles || std::regex_match(name, slice_re);
+}
+
+void SuspensionRecorder::snapshot(const fs::path& folder, const std::string& tag) {
+  const lbm::Lattice& lattice = solver_.suspension().lattice();
+  const double dx = solver_.options().dx_um, dt = solver_.options().dt_seconds;
+  const int j = lattice.ny() / 2;  // the node row nearest y = 0 (y = 1/2 dx for an even ny)
+  AtomicFile f(folder / fmt::format("fluid_{}.vtk", tag));
+  std::ostream& out = f.stream();
+  const Vec3 origin = lattice.position(0, j, 0) * dx;
+  out << "# vtk DataFile Version 3.0\n"
+      << fmt::format("bendlab fluid slice y = {:.6g} um at t = {:.9g} s\n", origin.y(), solver_.time())
+      << "ASCII\nDATASET STRUCTURED_POINTS\n"
+      << fmt::format("DIMENSIONS {} 1 {}\nORIGIN {:.9g} {:.9g} {:.9g}\nSPACING {:.9g} {:.9g} {:.9g}\n", lattice.nx(),
+                     lattice.nz(), origin.x(), origin.y(), origin.z(), dx, dx, dx)
+      << fmt::format("POINT_DATA {}\nVECTORS velocity_um_s double\n", lattice.nx() * lattice.nz());
+  for (int k = 0; k < lattice.nz(); ++k)
+    for (int i = 0; i < lattice.nx(); ++i) {
+      const Vec3 u = lattice.velocity(lattice.index(i, j, k)) * (dx / dt);
+      out << fmt::format("{:.9g} {:.9g} {:.9g}\n", u.x(), u.y(), u.z());
+    }
+  out << "SCALARS density_lattice double 1\nLOOKUP_TABLE default\n";
+  for (int k = 0; k < lattice.nz(); ++k)
+    for (int i = 0; i < lattice.nx(); ++i) out << fmt::format("{:.12g}\n", lattice.density(lattice.index(i, j, k)));
+  f.commit();
 }
 
 void SuspensionRecorder::start(const fs::path& folder, double t_end, bool writes_files) {

@@ -75,6 +75,10 @@ TEST_F(Cli, FlowStoppedAndResumedEqualsUninterrupted) {
   EXPECT_EQ(std::count(cells.begin(), cells.end(), '\n') - 1, 2 * (std::count(series.begin(), series.end(), '\n') - 1));
   EXPECT_TRUE(fs::exists(full / "profiles.csv"));
   EXPECT_TRUE(fs::exists(full / "snapshot_00002.vtp"));
+  // The fluid slice beside each snapshot: 10 x 14 nodes of the plane y = 0.
+  const std::string slice = slurp(full / "fluid_00002.vtk");
+  EXPECT_NE(slice.find("DIMENSIONS 10 1 14"), std::string::npos) << slice.substr(0, 300);
+  EXPECT_NE(slice.find("POINT_DATA 140"), std::string::npos);
 
   r = run("flow --cells 2 --stop-after-steps 5" + kSmallTube + " --out " + parts.string());
   ASSERT_EQ(r.status, 0) << r.err;
@@ -82,7 +86,7 @@ TEST_F(Cli, FlowStoppedAndResumedEqualsUninterrupted) {
   r = run("flow --cells 2 --resume" + kSmallTube + " --out " + parts.string());
   ASSERT_EQ(r.status, 0) << r.err;
   for (const char* file : {"timeseries.csv", "cells.csv", "profiles.csv", "summary.json", "shapes.pvd",
-                           "snapshot_00001.vtp", "snapshot_00002.vtp"})
+                           "snapshot_00001.vtp", "snapshot_00002.vtp", "fluid_00001.vtk", "fluid_00002.vtk"})
     EXPECT_EQ(slurp(parts / file), slurp(full / file)) << file;
   // Another seed is another run.
   r = run("flow --cells 2 --resume --seed 7" + kSmallTube + " --out " + parts.string());

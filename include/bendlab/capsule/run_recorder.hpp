@@ -56,6 +56,12 @@ class RunRecorder {
 
   /// Records an accepted step (appending to the files when writing them).
   virtual void record(const AcceptedStep& step) = 0;
+  /// Called with each snapshot of the bodies (snapshot_<tag>.vtp), before its checkpoint, when
+  /// the run writes files: a recorder may write files of its own for it (a fluid slice).
+  virtual void snapshot(const std::filesystem::path& folder, const std::string& tag) {
+    (void)folder;
+    (void)tag;
+  }
   /// The figures of the last recorded step for a progress line.
   virtual ProgressMeasures progress() const = 0;
 

@@ -15,6 +15,10 @@
 //                   velocity along x (um/s, the mean of its vertices'), the Taylor deformation D of
 //                   its equivalent ellipsoid, and the angle (degrees, 0..90) between its axis of
 //                   symmetry (the shortest axis) and the flow.
+//   fluid_NNNNN.vtk with each snapshot: the fluid's velocity and density on the plane y = 0
+//                   through the axis (tube) or the middle (channel), as VTK structured points
+//                   in um and um/s (ParaView reads it; the first of the plane's node rows
+//                   nearest y = 0).
 //   profiles.csv    at the end: across the section (r in a tube, z in a channel), in bins of one
 //                   dx, the steady window's mean fluid velocity and local hematocrit (the row
 //                   occupancy of the lines through the lattice nodes), and the nodes per bin.
@@ -68,6 +72,8 @@ class SuspensionRecorder final : public RunRecorder {
   void resume(const std::filesystem::path& folder, const CapsuleCheckpoint& saved, double t_end, bool writes_files,
               const std::function<void(const std::string&)>& note) override;
   void record(const AcceptedStep& step) override;
+  /// fluid_<tag>.vtk.
+  void snapshot(const std::filesystem::path& folder, const std::string& tag) override;
   /// H_D, eta_app / eta and the cell-free layer of the last row.
   ProgressMeasures progress() const override;
   nlohmann::json state() const override;
