@@ -209,9 +209,10 @@ void SuspensionRecorder::resume(const fs::path& folder, const CapsuleCheckpoint&
   velocity_sum_ = json_numbers(p.at("velocity_sum"), bin_lines_.size(), "velocity_sum");
   hematocrit_sum_ = json_numbers(p.at("hematocrit_sum"), bin_lines_.size(), "hematocrit_sum");
   profile_samples_ = p.at("samples").get<std::int64_t>();
-  saved_profiles_.reset();
-  if (p.contains("t_end") && p.at("t_end").is_number() &&
-      std::abs(p.at("t_end").get<double>() - t_end) > 1e-12 * t_end && note)
+  const bool window_moved = p.contains("t_end") && p.at("t_end").is_number() &&
+                            std::abs(p.at("t_end").get<double>() - t_end) > 1e-12 * t_end;
+  saved_profiles_.reset();  // p dangles from here on
+  if (window_moved && note)
     note("t_end moved the steady window: the profiles keep the samples of the old window, the summary's means are "
          "taken from timeseries.csv over the new one");
   if (!writes_files) return;
