@@ -76,7 +76,11 @@ std::shared_ptr<const MembraneModel> lattice_membrane(const CellKind& kind, cons
   p.kB = units.to_lattice_energy(s.bending_modulus);
   if (p.kB > 0) p.bending = make_bending_method(s.method, parse_options(s.method_options));
   if (s.volume_modulus_ratio > 0) {
-    p.volume_force = std::make_shared<const EspressoVolumeForce>(EspressoVolumeForce::for_membrane(p.kS, s.volume_modulus_ratio));
+    // kappa_V = ratio kS / R: the capsule runs' kappa_V = 100 kS in units of the cell's radius
+    // (cell_kind.hpp), here in lattice units, R = radius / dx.
+    const double radius_lattice = s.radius_um / units.input.dx_um;
+    p.volume_force = std::make_shared<const EspressoVolumeForce>(
+        EspressoVolumeForce::for_membrane(p.kS / radius_lattice, s.volume_modulus_ratio));
   }
   const TriMesh lattice_mesh = kind.reference_um.with_positions(kind.reference_um.positions() / units.input.dx_um);
   return std::make_shared<const MembraneModel>(lattice_mesh, std::move(p));

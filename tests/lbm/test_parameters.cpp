@@ -31,7 +31,7 @@ TEST(CapsuleRunParameters, PaperSetup) {
   EXPECT_DOUBLE_EQ(p.shear_rate, 2 * p.wall_velocity / p.nz);
   EXPECT_DOUBLE_EQ(p.mu * p.shear_rate * in.radius / p.kS, in.G);
   EXPECT_DOUBLE_EQ(p.kB / (in.radius * in.radius * p.kS), in.kB_hat);
-  EXPECT_DOUBLE_EQ(p.kV, 100 * p.kS);
+  EXPECT_DOUBLE_EQ(p.kV, 100 * p.kS / in.radius);  // 100 kS in units of R
   EXPECT_LT(p.mach, 0.01);
   EXPECT_GE(p.steps * p.shear_rate, 10.0);
   EXPECT_LT((p.steps - 1) * p.shear_rate, 10.0);

@@ -4,8 +4,10 @@
 //   shape      the red blood cell of the paper's eq. (15) with R = 3.91 um (diameter 7.82 um)
 //   mesh       mt1:1280 (1280 triangles, 642 vertices; edges about 0.45 um)
 //   membrane   Skalak law, G_s = 5.3 uN/m, C = 10; bending modulus 2e-19 J; Method C
-//   volume     ESPResSo's volume force with kappa_V = 100 kappa_S in lattice units, as the
-//              capsule runs use it
+//   volume     ESPResSo's volume force (membrane/espresso_volume_force.hpp) with
+//              kappa_V = 100 kappa_S / R, R the cell's radius: the capsule runs' kappa_V = 100 kS
+//              in their units of R (a force of kappa_V A_t grows with the square of the length
+//              unit, so a ratio to kS needs one; R keeps it the same at every dx)
 // Every cell of a kind shares its topology, reference shape and bending method: per cell a run
 // keeps positions and forces only.
 #include <memory>
@@ -30,7 +32,7 @@ struct CellKindSpec {
   double bending_modulus = 2e-19;     ///< kappa_B, J
   std::string method = "C";           ///< bending method
   std::vector<std::string> method_options;  ///< name=value
-  double volume_modulus_ratio = 100;  ///< kappa_V / kappa_S of ESPResSo's volume force (lattice units)
+  double volume_modulus_ratio = 100;  ///< kappa_V R / kappa_S of ESPResSo's volume force (R the radius)
 };
 
 /// Throws bendlab::Error, naming the option, for an unknown shape or law, a non-positive or

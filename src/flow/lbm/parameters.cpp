@@ -71,7 +71,7 @@ CapsuleRunParameters capsule_run_parameters(const CapsuleRunInput& in) {
   p.particle_reynolds = p.shear_rate * R * R / p.nu;
   p.kS = p.mu * p.shear_rate * R / in.G;
   p.kB = in.kB_hat * R * R * p.kS;
-  p.kV = in.kV_over_kS * p.kS;
+  p.kV = in.kV_over_kS * p.kS / R;  // kV = 100 kS in units of R (the header)
   p.steps = static_cast<std::int64_t>(std::ceil(in.gamma_t_end / p.shear_rate));
   if (in.reynolds > 0.3) {
     p.warnings.push_back(fmt::format("Reynolds number Re = R v / nu = {} is above the paper's bound 0.3", in.reynolds));

@@ -4,7 +4,9 @@
 //   nu = (tau - 1/2)/3, mu = rho0 nu; box nodes n = round(box/R * R) per axis, walls at z = -+nz/2;
 //   Re = R v / nu (the paper's Reynolds number) fixes the wall speed v = Re nu / R,
 //   gamma = 2 v / nz, Ma = v sqrt(3), Re_p = gamma R^2 / nu;
-//   kS = mu gamma R / G, kB = kB_hat R^2 kS, kV = 100 kS (ESPResSo's volume force);
+//   kS = mu gamma R / G, kB = kB_hat R^2 kS, kV = 100 kS / R (ESPResSo's volume force with
+//   kappa_V = 100 kappa_S in the run's units of R, where the membrane model works: its force
+//   kappa_V A_t grows with the square of the length unit, so in lattice units it is 100 kS / R);
 //   steps = ceil(gamma_t_end / gamma).
 #include <array>
 #include <cstdint>
