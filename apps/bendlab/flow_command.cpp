@@ -1,5 +1,5 @@
-// bendlab flow: red blood cells (or other cell kinds) in a tube or a slit channel, periodic along
-// the flow, on the lattice Boltzmann solver with the immersed boundary, in physical units
+// bendlab flow: red blood cells (or other cell kinds) in a tube, a slit channel or the shear box,
+// periodic along the flow, on the lattice Boltzmann solver with the immersed boundary, in physical units
 // (shared/spec/CELLS_IN_CHANNELS.md; docs/conventions.md §6). Argument parsing only: the run is
 // FlowRun (bendlab/flow/flow_run.hpp), whose folder belongs to the one run loop
 // (bendlab/capsule/capsule_run.hpp) with the suspension's recorder
@@ -18,7 +18,7 @@ namespace {
 
 struct FlowArgs {
   std::string geometry = "tube", out;
-  std::optional<double> diameter, height, width, pseudo_shear_rate, body_force, hematocrit;
+  std::optional<double> diameter, height, width, pseudo_shear_rate, body_force, shear_rate, hematocrit;
   std::optional<int> cells;
   double length = 0;
   double contact_force_pn = 0;
@@ -32,14 +32,16 @@ struct FlowArgs {
 void flow(FlowArgs& a) {
   FlowRunSpec& s = a.spec;
   const bool tube = a.geometry == "tube";
-  s.units.geometry = tube ? lbm::FlowGeometry::Tube : lbm::FlowGeometry::Channel;
+  s.units.geometry = tube                     ? lbm::FlowGeometry::Tube
+                     : a.geometry == "shear" ? lbm::FlowGeometry::Shear
+                                             : lbm::FlowGeometry::Channel;
   if (tube) {
     if (!a.diameter) throw Error("--diameter (um) is required for --geometry tube");
     if (a.height || a.width) throw Error("--height and --width are for --geometry channel (a tube takes --diameter)");
     s.units.diameter_um = *a.diameter;
   } else {
-    if (!a.height || !a.width) throw Error("--height and --width (um) are required for --geometry channel");
-    if (a.diameter) throw Error("--diameter is for --geometry tube (a channel takes --height and --width)");
+    if (!a.height || !a.width) throw Error(fmt::format("--height and --width (um) are required for --geometry {}", a.geometry));
+    if (a.diameter) throw Error(fmt::format("--diameter is for --geometry tube (a {} takes --height and --width)", a.geometry));
     s.units.height_um = *a.height;
     s.units.width_um = *a.width;
   }
@@ -47,6 +49,7 @@ void flow(FlowArgs& a) {
   s.units.length_um = a.length;
   s.units.pseudo_shear_rate = a.pseudo_shear_rate;
   s.units.body_force = a.body_force;
+  s.units.shear_rate = a.shear_rate;
   s.hematocrit = a.hematocrit;
   s.cells = a.cells;
   if (!a.hematocrit && !a.cells) throw Error("give --hematocrit (tube hematocrit, 0: plain Poiseuille flow) or --cells");
@@ -89,15 +92,17 @@ const CommandRegistration registration([](CLI::App& app) {
   auto args = std::make_shared<FlowArgs>();
   FlowRunSpec& s = args->spec;
   auto* cmd = app.add_subcommand(
-      "flow", "Simulate cells (red blood cells by default) in a tube or a slit channel, periodic along the flow, "
-              "with the immersed-boundary lattice Boltzmann method in physical units: apparent viscosity, "
+      "flow", "Simulate cells (red blood cells by default) in a tube, a slit channel or a shear box, periodic along "
+              "the flow, with the immersed-boundary lattice Boltzmann method in physical units: apparent viscosity, "
               "hematocrits, cell-free layer, profiles");
-  cmd->add_option("--geometry", args->geometry, "tube (a circular tube) or channel (plane walls at z = -+H/2, "
-                                                "periodic in y over --width)")
-      ->check(CLI::IsMember({"tube", "channel"}))->capture_default_str();
+  cmd->add_option("--geometry", args->geometry, "tube (a circular tube), channel (plane walls at z = -+H/2, "
+                                                "periodic in y over --width) or shear (walls at z = -+H/2 moving "
+                                                "with -+gamma H / 2 along x: the box of shear --solver lbm; one cell "
+                                                "sits at its centre)")
+      ->check(CLI::IsMember({"tube", "channel", "shear"}))->capture_default_str();
   cmd->add_option("--diameter", args->diameter, "tube diameter D, um (whole dx not needed: the wall is interpolated)");
-  cmd->add_option("--height", args->height, "channel height H (wall distance), um, a whole number of dx");
-  cmd->add_option("--width", args->width, "channel width (periodic, across the flow), um, a whole number of dx");
+  cmd->add_option("--height", args->height, "channel or shear box height H (wall distance), um, a whole number of dx");
+  cmd->add_option("--width", args->width, "channel or shear box width (periodic, across the flow), um, a whole number of dx");
   cmd->add_option("--length", args->length, "periodic length along the flow, um, a whole number of dx")->required();
   cmd->add_option("--dx", s.units.dx_um, "lattice spacing, um")->capture_default_str();
   cmd->add_option("--tau", s.units.tau, "LBM relaxation time, > 1/2: sets dt = (tau - 1/2) dx^2 / (3 nu)")
@@ -106,12 +111,15 @@ const CommandRegistration registration([](CLI::App& app) {
                                "driving as the pseudo-shear rate v / D (v / H) of the cell-free flow, 1/s (v its "
                                "mean velocity, Pries' measure)");
   auto* force = cmd->add_option("--body-force", args->body_force, "driving as a body force density along x, N/m^3");
+  auto* shear_rate = cmd->add_option("--shear-rate", args->shear_rate,
+                                     "the shear box's driving: its walls' shear rate gamma, 1/s");
   rate->excludes(force);
+  shear_rate->excludes(rate)->excludes(force);
   cmd->add_option("--plasma-viscosity", s.units.plasma.viscosity, "Pa s")->capture_default_str();
   cmd->add_option("--plasma-density", s.units.plasma.density, "kg/m^3")->capture_default_str();
   auto* hct = cmd->add_option("--hematocrit", args->hematocrit,
-                              "target tube hematocrit H_T in [0, 1) (0: plain Poiseuille flow); placement reports "
-                              "what it reached and refuses what it cannot place");
+                              "target tube hematocrit H_T in [0, 1) (0: plain Poiseuille flow; in the shear box the "
+                              "cells' volume fraction); placement reports what it reached and refuses what it cannot place");
   auto* count = cmd->add_option("--cells", args->cells, "a number of cells instead of --hematocrit");
   hct->excludes(count);
   cmd->add_option("--seed", s.seed, "placement seed")->capture_default_str();

@@ -19,17 +19,20 @@ void bind_flow(py::module_& m) {
       "flow_run",
       [](const std::filesystem::path& folder, const std::string& geometry, std::optional<double> diameter,
          std::optional<double> height, std::optional<double> width, double length, double dx, double tau,
-         std::optional<double> pseudo_shear_rate, std::optional<double> body_force, std::optional<double> hematocrit,
+         std::optional<double> pseudo_shear_rate, std::optional<double> body_force, std::optional<double> shear_rate,
+         std::optional<double> hematocrit,
          std::optional<int> cells, std::uint64_t seed, const std::string& cell, double cell_radius,
          const std::string& mesh, const std::string& method, const std::vector<std::string>& method_options,
          const std::string& membrane, double shear_modulus, double skalak_c, double bending_modulus,
          double volume_ratio, double contact_cutoff, double contact_force, double t_end, double sample_every,
          double snapshot_every, double steady_from, double slice_width, bool resume, bool overwrite,
          std::int64_t stop_after_steps, const py::object& progress, double progress_interval) -> py::object {
-        if (geometry != "tube" && geometry != "channel")
-          throw Error(fmt::format("geometry '{}' is not tube or channel", geometry));
+        if (geometry != "tube" && geometry != "channel" && geometry != "shear")
+          throw Error(fmt::format("geometry '{}' is not tube, channel or shear", geometry));
         FlowRunSpec s;
-        s.units.geometry = geometry == "tube" ? lbm::FlowGeometry::Tube : lbm::FlowGeometry::Channel;
+        s.units.geometry = geometry == "tube"    ? lbm::FlowGeometry::Tube
+                           : geometry == "shear" ? lbm::FlowGeometry::Shear
+                                                 : lbm::FlowGeometry::Channel;
         s.units.diameter_um = diameter.value_or(0);
         s.units.height_um = height.value_or(0);
         s.units.width_um = width.value_or(0);
@@ -38,6 +41,7 @@ void bind_flow(py::module_& m) {
         s.units.tau = tau;
         s.units.pseudo_shear_rate = pseudo_shear_rate;
         s.units.body_force = body_force;
+        s.units.shear_rate = shear_rate;
         s.hematocrit = hematocrit;
         s.cells = cells;
         if (!hematocrit && !cells) throw Error("give hematocrit (0: plain Poiseuille flow) or cells");
@@ -82,7 +86,7 @@ void bind_flow(py::module_& m) {
       py::arg("folder"), py::arg("geometry") = "tube", py::arg("diameter") = py::none(),
       py::arg("height") = py::none(), py::arg("width") = py::none(), py::arg("length"), py::arg("dx") = 0.5,
       py::arg("tau") = 1.0, py::arg("pseudo_shear_rate") = py::none(), py::arg("body_force") = py::none(),
-      py::arg("hematocrit") = py::none(), py::arg("cells") = py::none(), py::arg("seed") = 1,
+      py::arg("shear_rate") = py::none(), py::arg("hematocrit") = py::none(), py::arg("cells") = py::none(), py::arg("seed") = 1,
       py::arg("cell") = "rbc", py::arg("cell_radius") = 3.91, py::arg("mesh") = "mt1:1280", py::arg("method") = "C",
       py::arg("method_options") = std::vector<std::string>{}, py::arg("membrane") = "skalak",
       py::arg("shear_modulus") = 5.3e-6, py::arg("skalak_c") = 10.0, py::arg("bending_modulus") = 2e-19,
@@ -91,7 +95,8 @@ void bind_flow(py::module_& m) {
       py::arg("steady_from") = 0.5, py::arg("slice_width") = 1.0, py::arg("resume") = false,
       py::arg("overwrite") = false, py::arg("stop_after_steps") = 0, py::arg("progress") = py::none(),
       py::arg("progress_interval") = 2.0,
-      "Runs cells in a tube (`diameter`) or a slit channel (`height`, `width`), periodic over `length` (um), on the "
+      "Runs cells in a tube (`diameter`), a slit channel or a shear box (`height`, `width`; the box driven by "
+      "`shear_rate`), periodic over `length` (um), on the "
       "immersed-boundary lattice Boltzmann solver in physical units, as `bendlab flow` does (the same run folder: "
       "timeseries.csv, cells.csv, profiles.csv, snapshots, checkpoint.json, summary.json; see its --help for every "
       "option, here in snake case; contact_force in N, moduli in N/m and J, times in s). Returns summary.json's "

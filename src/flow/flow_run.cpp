@@ -10,6 +10,7 @@ namespace bendlab {
 nlohmann::json FlowRunSpec::to_json() const {
   const lbm::FlowUnitsInput& u = units;
   const bool tube = u.geometry == lbm::FlowGeometry::Tube;
+  const bool shear = u.geometry == lbm::FlowGeometry::Shear;
   nlohmann::json j = {{"geometry", lbm::to_string(u.geometry)},
                       {"length_um", u.length_um},
                       {"dx_um", u.dx_um},
@@ -39,6 +40,7 @@ nlohmann::json FlowRunSpec::to_json() const {
     j["width_um"] = u.width_um;
   }
   if (u.pseudo_shear_rate) j["pseudo_shear_rate"] = *u.pseudo_shear_rate;
+  if (shear && u.shear_rate) j["shear_rate"] = *u.shear_rate;
   if (u.body_force) j["body_force"] = *u.body_force;
   if (hematocrit) j["hematocrit"] = *hematocrit;
   if (cells) j["cells"] = *cells;
@@ -67,6 +69,8 @@ const FlowRunSpec& checked(const FlowRunSpec& s) {
 
 Vessel vessel_of(const lbm::FlowUnitsInput& u, double scale) {
   if (u.geometry == lbm::FlowGeometry::Tube) return Vessel::tube(u.diameter_um * scale, u.length_um * scale);
+  if (u.geometry == lbm::FlowGeometry::Shear)
+    return Vessel::box(u.height_um * scale, u.width_um * scale, u.length_um * scale);
   return Vessel::channel(u.height_um * scale, u.width_um * scale, u.length_um * scale);
 }
 
@@ -78,6 +82,7 @@ FlowRun::FlowRun(const FlowRunSpec& spec, const std::function<void(const std::st
     if (note) note(s);
   };
   const double dx = spec_.units.dx_um;
+  const bool shear = spec_.units.geometry == lbm::FlowGeometry::Shear;
   vessel_um_ = vessel_of(spec_.units, 1.0);
   const double cutoff_um = spec_.contact_cutoff_um > 0 ? spec_.contact_cutoff_um : dx;
   const double contact_force = spec_.contact_force > 0 ? spec_.contact_force : spec_.cell.shear_modulus * dx * 1e-6;
@@ -92,7 +97,11 @@ FlowRun::FlowRun(const FlowRunSpec& spec, const std::function<void(const std::st
     Vec3 extent = ref.colwise().maxCoeff() - ref.colwise().minCoeff();
     std::sort(extent.data(), extent.data() + 3);
     const bool tube_geometry = spec_.units.geometry == lbm::FlowGeometry::Tube;
-    const double needed = tube_geometry ? extent[1] : extent[0];
+    // The centred cell of a shear box stands as it is: its own z extent must fit.
+    const double needed = tube_geometry ? extent[1]
+                          : shear && spec_.cells == 1
+                              ? ref.col(2).maxCoeff() - ref.col(2).minCoeff()
+                              : extent[0];
     const double section = tube_geometry ? spec_.units.diameter_um : spec_.units.height_um;
     if (needed + 2 * 0.5 * cutoff_um >= section)
       throw Error(fmt::format("{} {} um is narrower than the cell: a {} of {} um across at best (its wall clearance "
@@ -106,7 +115,15 @@ FlowRun::FlowRun(const FlowRunSpec& spec, const std::function<void(const std::st
     // room to place H_T 0.3 in a 10 um tube.
     p.clearance = 0.5 * cutoff_um;
     p.seed = spec_.seed;
-    placement_ = place_cells(vessel_um_, *kind_.reference_um.topology_ptr(), kind_.reference_um.positions(), p);
+    if (shear && spec_.cells == 1) {
+      // One cell in the shear box sits where `bendlab shear --solver lbm` puts its capsule: its
+      // volume centroid at the box centre, its axis along z, unrotated.
+      placement_.cells.assign(1, PlacedCell{});
+      placement_.cell_volume = kind_.volume_um3;
+      placement_.hematocrit = kind_.volume_um3 / vessel_um_.volume();
+    } else {
+      placement_ = place_cells(vessel_um_, *kind_.reference_um.topology_ptr(), kind_.reference_um.positions(), p);
+    }
     say(fmt::format("placed {} cells at tube hematocrit {:.4g} (seed {}, {} attempts)", placement_.cells.size(),
                     placement_.hematocrit, spec_.seed, placement_.attempts));
   }
@@ -122,8 +139,16 @@ FlowRun::FlowRun(const FlowRunSpec& spec, const std::function<void(const std::st
   o.sample_every = spec_.sample_every;
   solver_ = std::make_unique<LbmSuspensionSolver>(o);
 
-  // The cell-free flow from the analytic Poiseuille profile, relaxed on the lattice.
   lbm::Lattice& lattice = solver_->suspension().lattice();
+  if (shear) {
+    // The walls' linear shear flow with its stress is a steady state of the lattice: no
+    // relaxation, and no reference flow rate (the recorder reads the walls' stress instead).
+    lattice.initialise_shear_flow();
+    say(fmt::format("cell-free flow: the linear shear flow of the walls, {:.4g} 1/s", units_.pseudo_shear_rate));
+    add_cells();
+    return;
+  }
+  // The cell-free flow from the analytic Poiseuille profile, relaxed on the lattice.
   const bool tube = spec_.units.geometry == lbm::FlowGeometry::Tube;
   const double half = 0.5 * units_.section_lattice;  // R or H / 2 in dx
   const double v = units_.to_lattice_velocity(units_.mean_velocity);
@@ -162,7 +187,10 @@ FlowRun::FlowRun(const FlowRunSpec& spec, const std::function<void(const std::st
   // The run starts at step 0 from the relaxed flow (the relaxation took a multiple of 100 steps,
   // so the populations are in the AA layout of an even step, as at step 0).
   lattice.restore_raw(lattice.raw_populations(), 0);
+  add_cells();
+}
 
+void FlowRun::add_cells() {
   const std::shared_ptr<const MembraneModel> membrane = lattice_membrane(kind_, units_);
   for (const PlacedCell& c : placement_.cells)
     solver_->add_cell(membrane, placed_positions(kind_.reference_um.positions(), c));
@@ -171,13 +199,16 @@ FlowRun::FlowRun(const FlowRunSpec& spec, const std::function<void(const std::st
 std::vector<std::string> FlowRun::describe() const {
   std::vector<std::string> lines = units_.describe();
   const double R = spec_.cell.radius_um * 1e-6;
-  // The capillary number of the cells: eta v R / (G_s D), v / D the pseudo-shear rate.
+  // The capillary number of the cells: eta v R / (G_s D), v / D the pseudo-shear rate (in the
+  // shear box the walls' shear rate gamma: eta gamma R / G_s).
   const double ca = spec_.units.plasma.viscosity * units_.pseudo_shear_rate * R / spec_.cell.shear_modulus;
+  const bool shear = spec_.units.geometry == lbm::FlowGeometry::Shear;
   lines.push_back(fmt::format("cells: {} x {} ({}, {}; G_s = {:.3g} N/m, kappa_B = {:.3g} J, Method {}), "
-                              "tube hematocrit {:.4g}; capillary number eta (v/D) R / G_s = {:.3g}",
+                              "{} {:.4g}; capillary number {} = {:.3g}",
                               placement_.cells.size(), spec_.cell.shape, spec_.cell.mesh, spec_.cell.elastic_law,
                               spec_.cell.shear_modulus, spec_.cell.bending_modulus, spec_.cell.method,
-                              placement_.hematocrit, ca));
+                              shear ? "volume fraction" : "tube hematocrit", placement_.hematocrit,
+                              shear ? "eta gamma R / G_s" : "eta (v/D) R / G_s", ca));
   return lines;
 }
 

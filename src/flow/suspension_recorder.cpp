@@ -10,6 +10,7 @@
 #include "bendlab/capsule/capsule_shape.hpp"
 #include "bendlab/capsule/checkpoint.hpp"
 #include "bendlab/core/atomic_file.hpp"
+#include "bendlab/flow/lbm/wall_stress.hpp"
 #include "bendlab/suspension/flow_measures.hpp"
 
 namespace fs = std::filesystem;
@@ -108,8 +109,8 @@ const char* SuspensionRecorder::series_header() {
 const char* SuspensionRecorder::cells_header() { return "t_s,cell,x_um,y_um,z_um,u_um_s,D,axis_angle_deg"; }
 
 SuspensionRecorder::SuspensionRecorder(const LbmSuspensionSolver& solver, SuspensionRecorderOptions options)
-    : solver_(solver), options_(std::move(options)) {
-  if (!(options_.reference_flow_rate > 0) || !std::isfinite(options_.reference_flow_rate))
+    : solver_(solver), options_(std::move(options)), shear_box_(solver.suspension().lattice().shear_rate() > 0) {
+  if (!shear_box_ && (!(options_.reference_flow_rate > 0) || !std::isfinite(options_.reference_flow_rate)))
     throw Error(fmt::format("suspension recorder: the cell-free flow rate {} must be positive",
                             options_.reference_flow_rate));
   if (!(options_.slice_width_um > 0) || !std::isfinite(options_.slice_width_um))
@@ -257,9 +258,13 @@ void SuspensionRecorder::record(const AcceptedStep& s) {
     }
   }
   const double H_T = cells ? tube_hematocrit(v, rows) : 0.0;
-  const double H_D = cells ? discharge_hematocrit(v, rows, U, Q) : 0.0;
+  // The shear box carries no net flux through a cross-section: no discharge hematocrit, and the
+  // viscosity from the walls' stress instead of the flow rate.
+  const double H_D = shear_box_ ? kNaN : cells ? discharge_hematocrit(v, rows, U, Q) : 0.0;
   const double cfl = cells ? cell_free_layer(v, x, options_.slice_width_um) : kNaN;
-  last_ = {s.time, s.dt, Q, Q / area, options_.reference_flow_rate / Q, H_T, H_D, cfl};
+  const double eta = shear_box_ ? lbm::wall_shear_stress(lattice) / (lattice.viscosity() * lattice.shear_rate())
+                                : options_.reference_flow_rate / Q;
+  last_ = {s.time, s.dt, Q, Q / area, eta, H_T, H_D, cfl};
   if (series_) series_->append(last_);
 
   if (in_window) {
@@ -310,7 +315,11 @@ nlohmann::json SuspensionRecorder::summary(const fs::path& folder, double t_end,
   fields["steady_window_s"] = {begin, t_end};
   fields["steady_rows"] = window_rows;
   fields["cells"] = solver_.suspension().num_cells();
-  fields["reference_flow_rate_um3_s"] = options_.reference_flow_rate;
+  if (shear_box_) {
+    fields["shear_rate_1_s"] = solver_.suspension().lattice().shear_rate() / solver_.options().dt_seconds;
+  } else {
+    fields["reference_flow_rate_um3_s"] = options_.reference_flow_rate;
+  }
   // The profiles of the window.
   AtomicFile f(folder / kProfiles);
   f.stream() << (options_.vessel_um.kind() == VesselKind::Tube ? "r_um" : "z_um")

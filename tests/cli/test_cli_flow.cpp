@@ -1,7 +1,11 @@
 // bendlab flow as a user meets it: refusals before work, the plain Poiseuille flow, the files of a
 // run with cells, and a resume that ends as the uninterrupted run. Small spheres (42 vertices) in
 // a 5 um tube keep it cheap; the physics of many red blood cells is in the tube study.
+#include <fmt/format.h>
+
 #include <algorithm>
+#include <cmath>
+#include <map>
 #include <nlohmann/json.hpp>
 
 #include "cli/cli_fixture.hpp"
@@ -16,6 +20,30 @@ namespace {
 const std::string kSmallTube =
     " --diameter 5 --length 5 --dx 0.5 --pseudo-shear-rate 200 --cell sphere --cell-radius 1.2 --mesh mt1:80 "
     "--sample-every 1e-6 --snapshot-every 4e-6 --t-end 8e-6";
+
+// The numbers of a CSV file's column.
+std::vector<double> column(const std::string& csv, const std::string& name) {
+  std::istringstream in(csv);
+  std::string line, cell;
+  std::getline(in, line);
+  std::istringstream header(line);
+  int index = -1;
+  for (int k = 0; std::getline(header, cell, ','); ++k)
+    if (cell == name) index = k;
+  std::vector<double> v;
+  if (index < 0) return v;
+  while (std::getline(in, line)) {
+    std::istringstream row(line);
+    for (int k = 0; std::getline(row, cell, ','); ++k)
+      if (k == index) v.push_back(std::stod(cell));
+  }
+  return v;
+}
+
+std::vector<double> checkpoint_positions(const fs::path& folder) {
+  std::ifstream in(folder / "checkpoint.json");
+  return nlohmann::json::parse(in).at("solver_state").at("positions_lattice").get<std::vector<double>>();
+}
 }  // namespace
 
 TEST_F(Cli, FlowRefusesBadInputWithOneLineBeforeWork) {
@@ -92,4 +120,67 @@ TEST_F(Cli, FlowStoppedAndResumedEqualsUninterrupted) {
   r = run("flow --cells 2 --resume --seed 7" + kSmallTube + " --out " + parts.string());
   EXPECT_NE(r.status, 0);
   EXPECT_NE(r.err.find("seed"), std::string::npos) << r.err;
+}
+
+TEST_F(Cli, FlowShearWithoutCellsHasThePlasmaViscosity) {
+  // The walls' linear shear flow is a steady state of the lattice, and its wall stress is eta gamma.
+  const CliRun r = run("flow --geometry shear --height 4 --width 3 --length 3 --shear-rate 2000 --hematocrit 0 "
+                       "--t-end 4e-6 --sample-every 1e-6 --out " + (dir / "r").string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto s = nlohmann::json::parse(r.out);
+  EXPECT_NEAR(s.at("apparent_viscosity").at("mean").get<double>(), 1.0, 1e-12);
+  EXPECT_NEAR(s.at("mean_velocity_um_s").at("mean").get<double>(), 0.0, 1e-9);
+  EXPECT_TRUE(s.at("discharge_hematocrit").at("mean").is_null());  // no net flux to discharge
+  EXPECT_NEAR(s.at("shear_rate_1_s").get<double>(), 2000, 1e-9);
+  expect_refused(run("flow --geometry shear --height 4 --width 3 --length 3 --pseudo-shear-rate 100 --hematocrit 0 "
+                     "--out " + (dir / "q").string()),
+                 "--shear-rate", dir / "q");
+  expect_refused(run("flow --geometry shear --height 4 --width 3 --length 3 --hematocrit 0 --out " +
+                     (dir / "q").string()),
+                 "--shear-rate", dir / "q");
+  expect_refused(run("flow --geometry shear --height 4 --width 3 --length 3 --shear-rate 1e9 --hematocrit 0 --out " +
+                     (dir / "q").string()),
+                 "Mach", dir / "q");
+}
+
+// `shear --solver lbm` is the shear box of `flow` with one cell: the same lattice, capsule,
+// membrane and steps, given once in the shear command's units (R = mu = gamma = 1, G, kB_hat)
+// and once in physical ones. The runs differ only in the units the membrane's arithmetic is done
+// in (the shear command's in units of R, scaled to lattice forces afterwards; flow's in lattice
+// units), which rounds differently, by about 1e-16 relative per step: D and every vertex agree to
+// 1e-12, not bit for bit.
+TEST_F(Cli, FlowShearWithOneCellIsTheShearCommandsLatticeRun) {
+  const double R = 3, nz = 9, Re = 0.2, G = 0.1, kb_hat = 0.01, t_end = 0.305, sample = 0.02;  // gamma t
+  const double eta = 1.2e-3, rho = 1025, dx = 0.5e-6, nu_lattice = 1.0 / 6;                      // flow's defaults
+  const double gamma_lattice = 2 * (Re * nu_lattice / R) / nz, dt = nu_lattice * dx * dx / (eta / rho);
+  const double gamma = gamma_lattice / dt, radius = R * dx;
+  const double G_s = eta * gamma * radius / (3 * G);  // kS = 3 G_s = eta gamma R / G
+  const double kappa_b = kb_hat * radius * radius * 3 * G_s;
+  const fs::path a = dir / "shear", b = dir / "flow";
+  CliRun r = run(fmt::format("shear --solver lbm --shape sphere --mesh mt1:80 --membrane neo-hookean --G {} "
+                             "--kappa-b-hat {} --method C --radius-lu {} --box 3 3 3 --reynolds {} --t-end {} "
+                             "--sample-every {} --snapshot-every 0.15 --no-plot --out {}",
+                             G, kb_hat, R, Re, t_end, sample, a.string()));
+  ASSERT_EQ(r.status, 0) << r.err;
+  r = run(fmt::format("flow --geometry shear --height 4.5 --width 4.5 --length 4.5 --dx 0.5 --shear-rate {:.17g} "
+                      "--cells 1 --cell sphere --cell-radius {:.17g} --mesh mt1:80 --membrane neo-hookean "
+                      "--shear-modulus {:.17g} --bending-modulus {:.17g} --method C --t-end {:.17g} "
+                      "--sample-every {:.17g} --snapshot-every {:.17g} --out {}",
+                      gamma, radius * 1e6, G_s, kappa_b, t_end / gamma, sample / gamma, 0.15 / gamma, b.string()));
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string series = slurp(a / "timeseries.csv"), cells = slurp(b / "cells.csv");
+  const std::vector<double> D_shear = column(series, "D"), D_flow = column(cells, "D");
+  const std::vector<double> angle_shear = column(series, "axis_angle"), angle_flow = column(cells, "axis_angle_deg");
+  ASSERT_GE(D_shear.size(), 10u);
+  ASSERT_EQ(D_shear.size(), D_flow.size());
+  for (std::size_t k = 0; k < D_shear.size(); ++k) {
+    EXPECT_NEAR(D_flow[k], D_shear[k], 1e-12) << "row " << k;
+    // The shear command's axis angle is the short axis's in the shear plane from e_z towards e_x
+    // (unwrapped, radians); flow's is its angle to the flow direction e_x (degrees, 0 to 90).
+    EXPECT_NEAR(std::abs(std::cos(angle_flow[k] * M_PI / 180)), std::abs(std::sin(angle_shear[k])), 1e-9) << k;
+  }
+  EXPECT_GT(D_shear.back(), 0.01);  // the capsule did deform
+  const std::vector<double> X_shear = checkpoint_positions(a), X_flow = checkpoint_positions(b);
+  ASSERT_EQ(X_shear.size(), X_flow.size());
+  for (std::size_t k = 0; k < X_shear.size(); ++k) EXPECT_NEAR(X_flow[k], X_shear[k], 1e-12 * R) << k;
 }

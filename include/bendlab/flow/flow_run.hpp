@@ -1,5 +1,5 @@
 #pragma once
-// A run of many cells in a tube or a channel in physical units (shared/spec/CELLS_IN_CHANNELS.md;
+// A run of many cells in a tube, a channel or the shear box in physical units (shared/spec/CELLS_IN_CHANNELS.md;
 // docs/conventions.md §6): the units and the lattice (flow/lbm/physical_units.hpp), the cell kind
 // (cell_kind.hpp), the cells placed at a target hematocrit (suspension/placement.hpp), the
 // cell-free flow and its flow rate Q0, and then the one run loop (capsule/capsule_run.hpp) with
@@ -12,6 +12,12 @@
 // eta_app / eta = Q0 / Q compares two flows on the same lattice and the discretisation's error
 // cancels; the cells then start in that flow. Everything is deterministic: a resume builds the
 // same placement and Q0 and reads positions and fluid from the checkpoint.
+//
+// The shear box (geometry shear) starts from the walls' linear shear flow, a steady state of the
+// lattice, and has no Q0 (its recorder reads the walls' stress). One cell (`cells` = 1) sits
+// where `bendlab shear --solver lbm` puts its capsule, centred and unrotated, so that the shear
+// command's lattice run is this run with one cell (docs/conventions.md §6); more cells are placed
+// at random as in a tube.
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -75,6 +81,9 @@ class FlowRun {
   CapsuleRunResult run(CapsuleRunOptions options);
 
  private:
+  /// The placed cells, into the solver (after the fluid is set).
+  void add_cells();
+
   FlowRunSpec spec_;
   lbm::FlowUnits units_;
   CellKind kind_;

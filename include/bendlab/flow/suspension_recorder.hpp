@@ -11,6 +11,9 @@
 //     eta_app / eta = Q0 / Q, Q0 the flow rate of the cell-free flow on the same lattice with
 //                   the same driving (flow_run.hpp relaxes it before the run);
 //     H_T, H_D, the cell-free layer: suspension/flow_measures.hpp (slices of slice_width_um).
+//     In the shear box (a lattice whose walls move) the net flux is zero: eta_app / eta is the
+//     walls' shear stress over eta gamma (flow/lbm/wall_stress.hpp), the suspension's relative
+//     viscosity, and H_D is not defined (NaN in the file, null in the summary).
 //   cells.csv       one row per cell per reported step: t_s, cell, the centroid (um), its
 //                   velocity along x (um/s, the mean of its vertices'), the Taylor deformation D of
 //                   its equivalent ellipsoid, and the angle (degrees, 0..90) between its axis of
@@ -43,7 +46,7 @@ namespace bendlab {
 
 struct SuspensionRecorderOptions {
   Vessel vessel_um = Vessel::box(1, 1, 1);  ///< the vessel in um
-  double reference_flow_rate = 0;           ///< Q0, um^3/s (positive)
+  double reference_flow_rate = 0;           ///< Q0, um^3/s (positive; unused in the shear box)
   double slice_width_um = 1;                ///< the cell-free layer's slices along x
   double steady_from = 0.5;                 ///< the steady window starts at steady_from t_end
 };
@@ -61,7 +64,8 @@ MeanWithError mean_with_error(const std::vector<double>& values);
 
 class SuspensionRecorder final : public RunRecorder {
  public:
-  /// Keeps `solver` by reference. Throws bendlab::Error for a non-positive Q0, slice width or a
+  /// Keeps `solver` by reference. Throws bendlab::Error for a non-positive Q0 (outside the shear
+  /// box), slice width or a
   /// steady_from outside [0, 1).
   SuspensionRecorder(const LbmSuspensionSolver& solver, SuspensionRecorderOptions options);
 
@@ -87,6 +91,7 @@ class SuspensionRecorder final : public RunRecorder {
  private:
   const LbmSuspensionSolver& solver_;
   SuspensionRecorderOptions options_;
+  bool shear_box_ = false;  // the lattice's walls move: viscosity from their stress
   double t_end_ = 0;
   std::optional<RowFile> series_, cells_;
   NumberRow last_;

@@ -67,7 +67,9 @@ void LbmSuspension::step() {
     if (options_.cell_contact.max_force > 0 && cells_.size() > 1) {
       cell_contact_energy_ = contact_.add_cell_contact(options_.vessel, options_.cell_contact, X_, cell_of_, F_);
     }
-    if (options_.wall_contact.max_force > 0 && options_.vessel.kind() != VesselKind::Box) {
+    // A box's walls exist only where the lattice has them (the shear box's moving walls).
+    const bool walls = options_.vessel.kind() != VesselKind::Box || lattice_.config().walls;
+    if (options_.wall_contact.max_force > 0 && walls) {
       wall_contact_energy_ = add_wall_contact(options_.vessel, options_.wall_contact, X_, F_);
     }
     // 2-4, with the node velocities shared between overlapping stencils.

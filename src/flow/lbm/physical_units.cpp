@@ -26,9 +26,49 @@ int whole_cells(double size_um, double dx_um, const char* option) {
   return static_cast<int>(r);
 }
 
+// The shear box: walls at z = -+H/2 moving with -+v, gamma = 2 v / H (the header).
+FlowUnits shear_units(FlowUnits u) {
+  const FlowUnitsInput& in = u.input;
+  if (in.pseudo_shear_rate || in.body_force)
+    throw Error("the shear box is driven by its walls: give --shear-rate (1/s), not --pseudo-shear-rate or --body-force");
+  if (!in.shear_rate) throw Error("--shear-rate (1/s, the walls' shear rate) is required for --geometry shear");
+  if (!(*in.shear_rate > 0) || !std::isfinite(*in.shear_rate))
+    throw Error(fmt::format("--shear-rate {} must be finite and positive", *in.shear_rate));
+  require_positive(in.length_um, "--length");
+  require_positive(in.height_um, "--height");
+  require_positive(in.width_um, "--width");
+  u.nx = whole_cells(in.length_um, in.dx_um, "--length");
+  u.ny = whole_cells(in.width_um, in.dx_um, "--width");
+  u.nz = whole_cells(in.height_um, in.dx_um, "--height");
+  if (u.nz < 4) throw Error(fmt::format("--height {} um is {} dx: a shear box needs at least 4 dx between its walls", in.height_um, u.nz));
+  u.section_lattice = u.nz;
+  const double dx = in.dx_um * 1e-6, H = in.height_um * 1e-6;
+  u.nu = in.plasma.viscosity / in.plasma.density;
+  u.nu_lattice = (in.tau - 0.5) / 3.0;
+  u.dt = u.nu_lattice * dx * dx / u.nu;
+  u.pseudo_shear_rate = *in.shear_rate;
+  u.wall_velocity = 0.5 * u.pseudo_shear_rate * H;
+  u.max_velocity_lattice = u.to_lattice_velocity(u.wall_velocity);
+  u.mach = std::sqrt(3.0) * u.max_velocity_lattice;
+  u.reynolds = u.wall_velocity * 0.5 * H / u.nu;
+  if (!(u.mach <= in.max_mach)) {
+    throw Error(fmt::format("Mach number {:.3g} (wall lattice velocity {:.3g}) exceeds {}: lower the shear rate, the "
+                            "height, dx or tau",
+                            u.mach, u.max_velocity_lattice, in.max_mach));
+  }
+  return u;
+}
+
 }  // namespace
 
-std::string to_string(FlowGeometry geometry) { return geometry == FlowGeometry::Tube ? "tube" : "channel"; }
+std::string to_string(FlowGeometry geometry) {
+  switch (geometry) {
+    case FlowGeometry::Tube: return "tube";
+    case FlowGeometry::Channel: return "channel";
+    case FlowGeometry::Shear: return "shear";
+  }
+  return "unknown";
+}
 
 double FlowUnits::steps_for(double s) const { return std::ceil(s / dt - 1e-9); }
 
@@ -55,6 +95,8 @@ FlowUnits flow_units(const FlowUnitsInput& in) {
     throw Error(fmt::format("--tau {} must exceed 1/2 (the lattice viscosity (tau - 1/2)/3 must be positive)", in.tau));
   }
   require_positive(in.max_mach, "maximum Mach number");
+  if (in.geometry == FlowGeometry::Shear) return shear_units(u);
+  if (in.shear_rate) throw Error("--shear-rate drives the shear box (--geometry shear); a tube or a channel takes --pseudo-shear-rate or --body-force");
   if (in.pseudo_shear_rate.has_value() == in.body_force.has_value()) {
     throw Error("give the driving either as --pseudo-shear-rate (1/s) or as --body-force (N/m^3), one of them");
   }
@@ -117,6 +159,18 @@ FlowUnits flow_units(const FlowUnitsInput& in) {
 std::vector<std::string> FlowUnits::describe() const {
   const bool tube = input.geometry == FlowGeometry::Tube;
   std::vector<std::string> lines;
+  if (input.geometry == FlowGeometry::Shear) {
+    lines.push_back(fmt::format("shear box {} um between its walls ({} dx), {} um wide, {} um long; lattice {} x {} x {} "
+                                "nodes, dx = {} um",
+                                input.height_um, nz, input.width_um, input.length_um, nx, ny, nz, input.dx_um));
+    lines.push_back(fmt::format("plasma eta = {} Pa s, rho = {} kg/m^3 (nu = {:.4g} m^2/s); tau = {} (nu = {:.4g} dx^2/dt): dt = {:.4g} s",
+                                input.plasma.viscosity, input.plasma.density, nu, input.tau, nu_lattice, dt));
+    lines.push_back(fmt::format("driving: shear rate {:.4g} 1/s, walls moving with -+{:.4g} um/s ({:.4g} lattice)",
+                                pseudo_shear_rate, wall_velocity * 1e6, max_velocity_lattice));
+    lines.push_back(fmt::format("wall lattice velocity {:.4g}, Mach {:.3g}, Reynolds gamma H^2 / (4 nu) {:.3g}",
+                                max_velocity_lattice, mach, reynolds));
+    return lines;
+  }
   lines.push_back(fmt::format("{} {} um across ({:.4g} dx), {} um long; lattice {} x {} x {} nodes, dx = {} um",
                               to_string(input.geometry), tube ? input.diameter_um : input.height_um, section_lattice,
                               input.length_um, nx, ny, nz, input.dx_um));
@@ -134,6 +188,12 @@ LatticeConfig flow_lattice_config(const FlowUnits& u) {
   c.ny = u.ny;
   c.nz = u.nz;
   c.tau = u.input.tau;
+  if (u.input.geometry == FlowGeometry::Shear) {
+    c.walls = true;
+    c.wall_velocity = u.max_velocity_lattice;
+    c.collision = Collision::Auto;
+    return c;
+  }
   c.collision = Collision::TRT;
   c.body_force = Vec3(u.body_force_lattice, 0, 0);
   c.walls = false;

@@ -13,6 +13,14 @@
 //   g_lattice = g dt^2 / (rho dx),  u_lattice = u dt / dx,
 //   F_lattice = F dt^2 / (rho dx^4),  k_lattice = k dt^2 / (rho dx^3) (N/m),  E_lattice = E dt^2 / (rho dx^5),
 // Mach number Ma = sqrt(3) u_max,lattice, Reynolds number Re = v D / nu (or v H / nu).
+//
+// The shear box (geometry shear): plane walls at z = -+H/2 moving with -+v e_x, periodic in x
+// over the length and in y over the width, driven by the shear rate gamma = 2 v / H (1/s) alone:
+// the linear shear flow u = gamma z e_x of the cell-free fluid, the box of `bendlab shear
+// --solver lbm` in physical units. Its lattice has no solid layers (nz = H / dx, the walls
+// halfway beyond the outermost nodes) and the collision of the shear command (Collision::Auto:
+// BGK at tau = 1; a linear flow puts a bounce-back wall exactly halfway at any tau). There
+// u_max = v, Ma = sqrt(3) v_lattice and Re = v (H / 2) / nu = gamma H^2 / (4 nu).
 #include <optional>
 #include <string>
 #include <vector>
@@ -21,9 +29,9 @@
 
 namespace bendlab::lbm {
 
-enum class FlowGeometry { Tube, Channel };
+enum class FlowGeometry { Tube, Channel, Shear };
 
-/// "tube", "channel".
+/// "tube", "channel", "shear".
 std::string to_string(FlowGeometry geometry);
 
 /// Blood plasma at 37 C (docs/conventions.md §6: eta = 1.2 mPa s, rho = 1025 kg/m^3).
@@ -35,14 +43,15 @@ struct Plasma {
 struct FlowUnitsInput {
   FlowGeometry geometry = FlowGeometry::Tube;
   double diameter_um = 0;  ///< tube
-  double height_um = 0;    ///< channel: wall distance (z)
-  double width_um = 0;     ///< channel: periodic extent across the flow (y)
+  double height_um = 0;    ///< channel, shear: wall distance (z)
+  double width_um = 0;     ///< channel, shear: periodic extent across the flow (y)
   double length_um = 0;    ///< periodic extent along the flow (x)
   double dx_um = 0.5;
   double tau = 1.0;
   Plasma plasma;
   std::optional<double> pseudo_shear_rate;  ///< v / D or v / H, 1/s
   std::optional<double> body_force;         ///< g, N/m^3
+  std::optional<double> shear_rate;         ///< shear: gamma = 2 v / H, 1/s (the only driving)
   double max_mach = 0.1;                    ///< refused above this
 };
 
@@ -53,11 +62,12 @@ struct FlowUnits {
   double nu = 0, nu_lattice = 0;  ///< m^2/s, dx^2/dt
   double body_force = 0;          ///< g, N/m^3
   double body_force_lattice = 0;
-  double pseudo_shear_rate = 0;   ///< 1/s
-  double mean_velocity = 0;       ///< v of the cell-free flow, m/s
+  double pseudo_shear_rate = 0;   ///< 1/s (shear: the walls' shear rate gamma)
+  double mean_velocity = 0;       ///< v of the cell-free flow, m/s (shear: 0)
+  double wall_velocity = 0;       ///< shear: v of the top wall, m/s (0 otherwise)
   double max_velocity_lattice = 0;
   double mach = 0, reynolds = 0;
-  /// The section's size in dx: D / dx (tube) or H / dx (channel).
+  /// The section's size in dx: D / dx (tube) or H / dx (channel, shear).
   double section_lattice = 0;
 
   double dx() const { return input.dx_um * 1e-6; }
@@ -79,12 +89,14 @@ struct FlowUnits {
 /// Validates and converts. Throws bendlab::Error, naming the option, for: a non-positive or
 /// non-finite size, dx, viscosity or density; tau <= 1/2; a channel height, width or length, or a
 /// tube length, that is not a whole number of dx (within 1e-6 dx); a tube diameter below 4 dx;
-/// neither or both drivings, or a negative one; and a Mach number above max_mach.
+/// neither or both drivings, or a negative one (shear: a shear rate, and no other driving); and a
+/// Mach number above max_mach.
 FlowUnits flow_units(const FlowUnitsInput& input);
 
 /// The lattice of these units: TRT (walls exactly placed at any tau), the body force along x,
 /// and the cross-section: the tube's (TubeWall of radius D / (2 dx), interpolated bounce-back) or
-/// the channel's (SlabWall at z = -+H/2, halfway between nodes), periodic in x (and y).
+/// the channel's (SlabWall at z = -+H/2, halfway between nodes), periodic in x (and y); the shear
+/// box's moving walls (LatticeConfig::walls, the collision of the shear command) without a body force.
 LatticeConfig flow_lattice_config(const FlowUnits& units);
 
 }  // namespace bendlab::lbm
