@@ -21,6 +21,11 @@
 //                          On a shared machine run it with --benchmark_repetitions=3
 //                          --benchmark_enable_random_interleaving=true, so that a drift of the load
 //                          is not taken for an effect of the order.
+//   BM_ForcesRatio/M/over:C Method M's forces and Method C's in every iteration of one run (20480
+//                          triangles, one thread, the two shapes of BM_Forces): counter ratio =
+//                          (M's thread CPU time) / (C's), summed over the iterations, so that a drift
+//                          of the machine's speed during the run (another process on the sibling
+//                          core, the clock) falls on both alike; m_ms and c_ms are the per-call times.
 //   BM_MongeJetFit/<path>  Method M's fits alone (steps 3-5, METHOD_M.md) at every node of the RBC at
 //                          20480 triangles, one thread, on the 3-ring supports and covariance frames
 //                          the method uses: path lanes (monge_jet_fit_nodes, 8 nodes side by side in
@@ -41,6 +46,7 @@
 #include <sys/resource.h>
 
 #include <cmath>
+#include <ctime>
 #include <map>
 #include <memory>
 #include <string>
@@ -160,6 +166,47 @@ void BM_Forces(benchmark::State& state, const std::string& method) {
   set_counters(state, mesh, threads);
 }
 
+// The thread's CPU time in seconds.
+double thread_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
+// `method` and `reference` in turn on the shapes of BM_Forces (BM_ForcesRatio above).
+void BM_ForcesRatio(benchmark::State& state, const std::string& method, const std::string& reference) {
+  const TriMesh& mesh = rbc_mesh(static_cast<int>(state.range(0)));
+  omp_set_num_threads(1);
+  const auto m = make_bending_method(method), r = make_bending_method(reference);
+  Points force(mesh.num_vertices(), 3);
+  Points moved = mesh.positions();
+  for (Eigen::Index i = 0; i < moved.rows(); ++i) moved.row(i) *= 1.0 + 1e-3 * std::sin(3.0 * moved(i, 0));
+  const Points* shapes[2] = {&mesh.positions(), &moved};
+  for (const Points* x : shapes) {  // untimed: each method's set-up and workspace
+    m->forces(mesh.topology(), *x, 1.0, force);
+    r->forces(mesh.topology(), *x, 1.0, force);
+  }
+  double t_method = 0, t_reference = 0;
+  int k = 0;
+  for (auto _ : state) {
+    const Points& x = *shapes[k ^= 1];
+    const double t0 = thread_cpu_seconds();
+    r->forces(mesh.topology(), x, 1.0, force);
+    const double t1 = thread_cpu_seconds();
+    m->forces(mesh.topology(), x, 1.0, force);
+    const double t2 = thread_cpu_seconds();
+    benchmark::DoNotOptimize(force.data());
+    benchmark::ClobberMemory();
+    t_reference += t1 - t0;
+    t_method += t2 - t1;
+  }
+  const double calls = static_cast<double>(state.iterations());
+  state.counters["ratio"] = t_reference > 0 ? t_method / t_reference : 0.0;
+  state.counters["m_ms"] = 1e3 * t_method / calls;
+  state.counters["c_ms"] = 1e3 * t_reference / calls;
+  state.counters["triangles"] = mesh.num_faces();
+}
+
 // Method M's fits alone, by the batched path (lanes = true) or the per-node reference.
 void BM_MongeJetFit(benchmark::State& state, bool lanes) {
   const int degree = static_cast<int>(state.range(0));
@@ -208,6 +255,11 @@ void register_all() {
     auto* b = benchmark::RegisterBenchmark(("BM_Forces/" + method).c_str(), BM_Forces, method);
     b->ArgsProduct({{5120, 20480, 81920}, {1, 2}})->ArgNames({"triangles", "threads"})->UseRealTime()
         ->Unit(benchmark::kMillisecond);
+  }
+  {
+    auto* b = benchmark::RegisterBenchmark("BM_ForcesRatio/M/over:C", BM_ForcesRatio, std::string("M"),
+                                           std::string("C"));
+    b->Args({20480})->ArgNames({"triangles"})->UseRealTime()->Unit(benchmark::kMillisecond);
   }
   // Every method after every other, 81920 triangles, one thread. A fixed count of calls keeps the
   // 81 pairs to about a minute on the reference machine.

@@ -76,3 +76,40 @@ def test_repetitions_give_medians_and_noise(tmp_path):
     text = out.read_text()
     assert "the median of 3 repetitions" in text
     assert "| C | 11 | 10 | 1.10 | 9% | 0 |" in text
+
+
+def ratio_report(interleaved, apart):
+    """A bench_bending report with Method M's and C's forces timed apart (M `apart` times C) and in
+    turn (BM_ForcesRatio, M `interleaved` times C)."""
+    def row(name, real, cpu, **counters):
+        return dict({"name": name, "run_type": "iteration", "real_time": real, "cpu_time": cpu,
+                     "time_unit": "ms", "iterations": 10}, **counters)
+    return {"context": {}, "benchmarks": [
+        row("BM_Forces/C/triangles:20480/threads:1/real_time", 1.5, 1.5),
+        row("BM_Forces/M/triangles:20480/threads:1/real_time", 1.5 * apart, 1.5 * apart),
+        row("BM_ForcesRatio/M/over:C/triangles:20480/real_time", 16.0, 16.0, ratio=interleaved,
+            m_ms=1.5 * interleaved, c_ms=1.5)]}
+
+
+def m_target_line(tmp_path, interleaved, apart):
+    results = tmp_path / "results"
+    results.mkdir(exist_ok=True)
+    (results / "bench_bending.json").write_text(json.dumps(ratio_report(interleaved, apart)))
+    (results / "machine.txt").write_text("load_start: 0.5 0.6 0.7\nload_end: 0.8 0.9 1.0\n")
+    out = tmp_path / "benchmarks.md"
+    subprocess.run([sys.executable, str(SCRIPT), "--results", str(results), "--out", str(out)], check=True)
+    lines = [l for l in out.read_text().splitlines() if l.startswith("| Method M (`forces`)")]
+    assert len(lines) == 1
+    return lines[0]
+
+
+def test_method_m_target_is_judged_on_the_calls_in_turn(tmp_path):
+    # A machine that slowed down while M's forces ran alone: apart 12.3 times, in turn 9.0.
+    line = m_target_line(tmp_path, interleaved=9.0, apart=12.3)
+    assert "9.0 times" in line and "timed apart (BM_Forces): 12.3 times" in line
+    assert "| met |" in line
+
+
+def test_method_m_target_not_met_in_turn(tmp_path):
+    line = m_target_line(tmp_path, interleaved=11.0, apart=9.0)
+    assert "**not met**" in line
