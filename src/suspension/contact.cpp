@@ -36,7 +36,7 @@ double add_wall_contact(const Vessel& vessel, const ContactLaw& law, const Point
   return energy;
 }
 
-void ContactSearch::bin(const Vessel& vessel, const Points& x, double width) {
+void ContactSearch::bin(const Vessel& vessel, const Points& x, const std::vector<int>& cell_of, double width) {
   const Eigen::Index n = x.rows();
   const Vec3 period = vessel.period();
   for (int a = 0; a < 3; ++a) {
@@ -53,6 +53,7 @@ void ContactSearch::bin(const Vessel& vessel, const Points& x, double width) {
   }
   const std::size_t bins = static_cast<std::size_t>(nb_[0]) * nb_[1] * nb_[2];
   bin_of_.resize(n);
+  wrapped_.resize(n, 3);
   start_.assign(bins + 1, 0);
   items_.resize(n);
   for (Eigen::Index i = 0; i < n; ++i) {
@@ -60,6 +61,7 @@ void ContactSearch::bin(const Vessel& vessel, const Points& x, double width) {
     for (int a = 0; a < 3; ++a) {
       double c = x(i, a);
       if (vessel.periodic(a)) c -= period[a] * std::floor((c - lo_[a]) / period[a]);  // into [lo, lo + period)
+      wrapped_(i, a) = c;
       b[a] = std::clamp(static_cast<int>(std::floor((c - lo_[a]) / w_[a])), 0, nb_[a] - 1);
     }
     bin_of_[i] = b[0] + nb_[0] * (b[1] + nb_[1] * b[2]);
@@ -70,6 +72,22 @@ void ContactSearch::bin(const Vessel& vessel, const Points& x, double width) {
   for (Eigen::Index i = 0; i < n; ++i) items_[start_[bin_of_[i]]++] = static_cast<int>(i);
   for (std::size_t b = bins; b > 0; --b) start_[b] = start_[b - 1];
   start_[0] = 0;
+  // The wrapped positions and cells in bin order, for the pair loop to read front to back.
+  sorted_.resize(n, 3);
+  sorted_cell_.resize(n);
+  for (Eigen::Index s = 0; s < n; ++s) {
+    const int i = items_[s];
+    sorted_.row(s) = wrapped_.row(i);
+    sorted_cell_[s] = cell_of[i];
+  }
+  // Per bin: its one cell, kEmptyBin, or kMixedBin.
+  bin_cell_.assign(bins, kEmptyBin);
+  for (std::size_t b = 0; b < bins; ++b)
+    for (int s = start_[b]; s < start_[b + 1]; ++s) {
+      int& c = bin_cell_[b];
+      c = c == kEmptyBin || c == sorted_cell_[s] ? sorted_cell_[s] : kMixedBin;
+      if (c == kMixedBin) break;
+    }
 }
 
 template <class Visit>
@@ -78,37 +96,77 @@ void ContactSearch::for_each_pair(const Vessel& vessel, const Points& x, const s
   if (static_cast<Eigen::Index>(cell_of.size()) != x.rows()) {
     throw Error(fmt::format("contact search: {} cell indices for {} vertices", cell_of.size(), x.rows()));
   }
-  bin(vessel, x, range);
+  bin(vessel, x, cell_of, range);
   const double r2max = range * range;
-  for (Eigen::Index i = 0; i < x.rows(); ++i) {
-    const int b = bin_of_[i];
-    const int bx = b % nb_[0], by = (b / nb_[0]) % nb_[1], bz = b / (nb_[0] * nb_[1]);
-    const int home[3] = {bx, by, bz};
-    // The distinct neighbour bins along each axis (fewer than 3 when the axis has fewer bins).
+  const Vec3 period = vessel.period();
+  // With three bins or more along every periodic axis, each neighbour bin holds one image of its
+  // vertices within range: the one shifted by the period when the neighbour wraps around. With
+  // fewer, a bin can be its own neighbour on both sides and the nearest image is taken per pair.
+  bool shifted_images = true;
+  for (int a = 0; a < 3; ++a)
+    if (vessel.periodic(a) && nb_[a] < 3) shifted_images = false;
+  const int bins = nb_[0] * nb_[1] * nb_[2];
+  for (int b = 0; b < bins; ++b) {
+    if (start_[b] == start_[b + 1]) continue;
+    const int home[3] = {b % nb_[0], (b / nb_[0]) % nb_[1], b / (nb_[0] * nb_[1])};
+    // The distinct neighbour bins along each axis (fewer than 3 when the axis has fewer bins),
+    // with the shift that brings their vertices next to this bin's.
     int nbrs[3][3], count[3];
+    double shift[3][3];
     for (int a = 0; a < 3; ++a) {
       count[a] = 0;
       for (int o = -1; o <= 1; ++o) {
         int c = home[a] + o;
+        double sh = 0;
         if (vessel.periodic(a)) {
-          c = (c % nb_[a] + nb_[a]) % nb_[a];
+          if (c < 0) {
+            c += nb_[a];
+            sh = -period[a];
+          } else if (c >= nb_[a]) {
+            c -= nb_[a];
+            sh = period[a];
+          }
         } else if (c < 0 || c >= nb_[a]) {
           continue;
         }
-        if (std::find(nbrs[a], nbrs[a] + count[a], c) == nbrs[a] + count[a]) nbrs[a][count[a]++] = c;
+        if (std::find(nbrs[a], nbrs[a] + count[a], c) == nbrs[a] + count[a]) {
+          nbrs[a][count[a]] = c;
+          shift[a][count[a]++] = sh;
+        }
       }
     }
-    const Vec3 xi = row(x, i);
-    for (int iz = 0; iz < count[2]; ++iz) {
-      for (int iy = 0; iy < count[1]; ++iy) {
-        for (int ix = 0; ix < count[0]; ++ix) {
-          const int nb = nbrs[0][ix] + nb_[0] * (nbrs[1][iy] + nb_[1] * nbrs[2][iz]);
-          for (int s = start_[nb]; s < start_[nb + 1]; ++s) {
-            const int j = items_[s];
-            if (j <= i || cell_of[j] == cell_of[i]) continue;
-            const Vec3 d = vessel.minimum_image(xi - row(x, j));
-            const double r2 = d.squaredNorm();
-            if (r2 < r2max) visit(static_cast<int>(i), j, d, std::sqrt(r2));
+    // Most bins see one cell only (the inside of a membrane far from the others): nothing to do.
+    const int own = bin_cell_[b];
+    bool foreign = own == kMixedBin;
+    for (int iz = 0; iz < count[2] && !foreign; ++iz)
+      for (int iy = 0; iy < count[1] && !foreign; ++iy)
+        for (int ix = 0; ix < count[0] && !foreign; ++ix) {
+          const int c = bin_cell_[nbrs[0][ix] + nb_[0] * (nbrs[1][iy] + nb_[1] * nbrs[2][iz])];
+          foreign = c != kEmptyBin && c != own;
+        }
+    if (!foreign) continue;
+    for (int t = start_[b]; t < start_[b + 1]; ++t) {
+      const int i = items_[t];
+      const int ci = sorted_cell_[t];
+      const double xi = sorted_(t, 0), yi = sorted_(t, 1), zi = sorted_(t, 2);
+      for (int iz = 0; iz < count[2]; ++iz) {
+        for (int iy = 0; iy < count[1]; ++iy) {
+          for (int ix = 0; ix < count[0]; ++ix) {
+            const int nb = nbrs[0][ix] + nb_[0] * (nbrs[1][iy] + nb_[1] * nbrs[2][iz]);
+            const double ox = xi - shift[0][ix], oy = yi - shift[1][iy], oz = zi - shift[2][iz];
+            for (int s = start_[nb]; s < start_[nb + 1]; ++s) {
+              if (sorted_cell_[s] == ci) continue;
+              const int j = items_[s];
+              if (j <= i) continue;
+              Vec3 d;
+              if (shifted_images) {
+                d = Vec3(ox - sorted_(s, 0), oy - sorted_(s, 1), oz - sorted_(s, 2));
+              } else {
+                d = vessel.minimum_image(row(x, i) - row(x, j));
+              }
+              const double r2 = d.squaredNorm();
+              if (r2 < r2max) visit(i, j, d, std::sqrt(r2));
+            }
           }
         }
       }

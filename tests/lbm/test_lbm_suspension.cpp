@@ -7,6 +7,8 @@
 #include <cmath>
 #include <memory>
 
+#include <omp.h>
+
 #include "bendlab/flow/lbm/lbm_suspension.hpp"
 #include "bendlab/flow/lbm/section_walls.hpp"
 #include "bendlab/geometry/measures.hpp"
@@ -175,4 +177,32 @@ TEST(LbmSuspension, CellLeavingTheBoxComesBackWhole) {
   EXPECT_NEAR(xc1 + 16 - xc0, 1.2, 0.1);        // moved by the flow's 0.02 per step, up to the period
   const Points x = s.cell_positions(0);
   EXPECT_LT(x.col(0).maxCoeff() - x.col(0).minCoeff(), 6.5);  // its vertices together, not split
+}
+
+// The cells' forces on one or two threads, and the immersed boundary's: the same positions bit for
+// bit (each cell's forces are its own; the stencil sums keep their order).
+TEST(LbmSuspension, ThreadCountDoesNotChangeTheRun) {
+  auto run = [](int threads) {
+    const int saved = omp_get_max_threads();
+    omp_set_num_threads(threads);
+    SuspensionOptions o;
+    o.lattice.nx = 24;
+    o.lattice.ny = 14;
+    o.lattice.nz = 16;
+    o.lattice.walls = true;
+    o.lattice.wall_velocity = 0.05;
+    o.vessel = Vessel::box(16, 14, 24);
+    o.cell_contact = ContactLaw{0.02, 1.5};
+    LbmSuspension s(o);
+    s.lattice().initialise_shear_flow();
+    const auto m = rbc(3.5, 0.005);
+    s.add_cell(m, moved(m->reference_positions(), Vec3(-3.0, 0, 1.0), 1.4));
+    s.add_cell(m, moved(m->reference_positions(), Vec3(3.0, 0, -1.0), -1.4));
+    s.add_cell(m, moved(m->reference_positions(), Vec3(9.0, 0, 3.5), 0.3));
+    s.run(40);
+    omp_set_num_threads(saved);
+    return Points(s.positions());
+  };
+  const Points one = run(1), two = run(2);
+  EXPECT_EQ(one, two);
 }

@@ -12,7 +12,8 @@
 // membrane's own elasticity keeps its shape.
 //
 // Pairs are found with a uniform cell list of bins at least r_c wide; separations take the
-// nearest periodic image (Vessel::minimum_image), so positions may be unwrapped. ContactSearch
+// nearest periodic image (the image in the neighbour bin, or Vessel::minimum_image where an axis
+// has fewer than three bins), so positions may be unwrapped. ContactSearch
 // keeps its bins between calls: once warm it allocates nothing.
 #include <vector>
 
@@ -44,14 +45,17 @@ class ContactSearch {
   double min_cell_distance(const Vessel& vessel, const Points& x, const std::vector<int>& cell_of, double range);
 
  private:
-  // Bins the rows of x (bins at least `width` wide); the pairs then come from bin_pairs.
-  void bin(const Vessel& vessel, const Points& x, double width);
+  // Bins the rows of x (bins at least `width` wide), with their positions wrapped into the period
+  // and, in bin order, those positions and cells; the pairs then come from for_each_pair.
+  void bin(const Vessel& vessel, const Points& x, const std::vector<int>& cell_of, double width);
   template <class Visit>
   void for_each_pair(const Vessel& vessel, const Points& x, const std::vector<int>& cell_of, double range, Visit&& visit);
 
   int nb_[3] = {0, 0, 0};
   double lo_[3] = {0, 0, 0}, w_[3] = {1, 1, 1};
-  std::vector<int> bin_of_, start_, items_;
+  static constexpr int kEmptyBin = -1, kMixedBin = -2;
+  std::vector<int> bin_of_, start_, items_, sorted_cell_, bin_cell_;
+  Points wrapped_, sorted_;
 };
 
 }  // namespace bendlab

@@ -118,34 +118,87 @@ void interpolate_velocity(const Lattice& lattice, const Points& X, Points& U, Ib
   if (failed) throw Error(message);
 }
 
-void IbInterpolator::interpolate(const Lattice& lattice, const Points& X, Points& U, IbKernel kernel) {
-  const std::size_t n = lattice.num_nodes();
-  if (stamp_.size() != n) {
-    stamp_.assign(n, 0);
-    velocity_.assign(3 * n, 0.0);
-    current_ = 0;
-  }
-  if (++current_ == 0) {  // the stamps wrapped around: start afresh
-    std::fill(stamp_.begin(), stamp_.end(), 0);
-    current_ = 1;
-  }
-  U.resize(X.rows(), 3);
-  for (Eigen::Index k = 0; k < X.rows(); ++k) {
-    const IbStencil st = ib_stencil(lattice, row(X, k), kernel);
-    Vec3 u = Vec3::Zero();
-    for (int s = 0; s < st.size; ++s) {
-      if (st.weight[s] == 0.0) continue;
-      const std::size_t node = st.node[s];
-      double* v = velocity_.data() + 3 * node;
-      if (stamp_[node] != current_) {
-        const Vec3 w = lattice.velocity(node);
-        v[0] = w.x(), v[1] = w.y(), v[2] = w.z();
-        stamp_[node] = current_;
+void IbInterpolator::prepare(const Lattice& lattice, const Points& X, IbKernel kernel) {
+  const int m = static_cast<int>(std::ceil(ib_kernel_half_width(kernel)));
+  per_node_ = 8 * m * m * m;  // (2 m)^3
+  nodes_ = X.rows();
+  lattice_nodes_ = lattice.num_nodes();
+  node_.resize(static_cast<std::size_t>(nodes_) * per_node_);
+  weight_.resize(node_.size());
+  bool failed = false;
+  std::string message;
+#pragma omp parallel for schedule(static) if (nodes_ >= 256)
+  for (Eigen::Index k = 0; k < nodes_; ++k) {
+    try {
+      const IbStencil st = ib_stencil(lattice, row(X, k), kernel);
+      const std::size_t at = static_cast<std::size_t>(k) * per_node_;
+      std::copy_n(st.node.begin(), per_node_, node_.begin() + static_cast<std::ptrdiff_t>(at));
+      std::copy_n(st.weight.begin(), per_node_, weight_.begin() + static_cast<std::ptrdiff_t>(at));
+    } catch (const Error& e) {
+#pragma omp critical
+      {
+        if (!failed) message = fmt::format("IB node {}: {}", k, e.what());
+        failed = true;
       }
-      u += st.weight[s] * Vec3(v[0], v[1], v[2]);
+    }
+  }
+  if (failed) {
+    nodes_ = 0;
+    throw Error(message);
+  }
+}
+
+void IbInterpolator::spread(Lattice& lattice, const Points& F) const {
+  if (F.rows() != nodes_) throw Error(fmt::format("IB spreading: {} prepared positions but {} forces", nodes_, F.rows()));
+  if (lattice.num_nodes() != lattice_nodes_) throw Error("IB spreading: the stencils were prepared on another lattice");
+  for (Eigen::Index k = 0; k < nodes_; ++k) {
+    const Vec3 Fk = row(F, k);
+    const std::size_t at = static_cast<std::size_t>(k) * per_node_;
+    for (int s = 0; s < per_node_; ++s) {
+      const double w = weight_[at + s];
+      if (w != 0.0) lattice.add_force(node_[at + s], w * Fk);
+    }
+  }
+}
+
+void IbInterpolator::interpolate(const Lattice& lattice, Points& U) {
+  const std::size_t n = lattice.num_nodes();
+  if (n != lattice_nodes_) throw Error("IB interpolation: the stencils were prepared on another lattice");
+  // The nodes in some stencil, ascending.
+  marks_.assign((n + 63) / 64, 0);
+  for (std::size_t e = 0; e < node_.size(); ++e)
+    if (weight_[e] != 0.0) marks_[node_[e] / 64] |= std::uint64_t{1} << (node_[e] % 64);
+  touched_.clear();
+  for (std::size_t w = 0; w < marks_.size(); ++w)
+    for (std::uint64_t bits = marks_[w]; bits != 0; bits &= bits - 1)
+      touched_.push_back(64 * w + static_cast<std::size_t>(__builtin_ctzll(bits)));
+  // Their velocities, then each node's stencil sum.
+  if (velocity_.size() != 3 * n) velocity_.assign(3 * n, 0.0);
+  const auto touched = static_cast<std::ptrdiff_t>(touched_.size());
+#pragma omp parallel for schedule(static) if (touched >= 4096)
+  for (std::ptrdiff_t t = 0; t < touched; ++t) {
+    const std::size_t node = touched_[static_cast<std::size_t>(t)];
+    const Vec3 v = lattice.velocity(node);
+    velocity_[3 * node] = v.x(), velocity_[3 * node + 1] = v.y(), velocity_[3 * node + 2] = v.z();
+  }
+  U.resize(nodes_, 3);
+#pragma omp parallel for schedule(static) if (nodes_ >= 1024)
+  for (Eigen::Index k = 0; k < nodes_; ++k) {
+    const std::size_t at = static_cast<std::size_t>(k) * per_node_;
+    Vec3 u = Vec3::Zero();
+    for (int s = 0; s < per_node_; ++s) {
+      const double w = weight_[at + s];
+      if (w == 0.0) continue;
+      const double* v = velocity_.data() + 3 * node_[at + s];
+      u += w * Vec3(v[0], v[1], v[2]);
     }
     U.row(k) = u.transpose();
   }
+}
+
+void IbInterpolator::interpolate(const Lattice& lattice, const Points& X, Points& U, IbKernel kernel) {
+  prepare(lattice, X, kernel);
+  interpolate(lattice, U);
 }
 
 void euler_move(Points& X, const Points& U, double dt) {

@@ -491,6 +491,7 @@ Lattice::Lattice(const LatticeConfig& config) : config_(config) {
   n_ = static_cast<std::size_t>(config.nx) * config.ny * config.nz;
   fluid_nodes_ = n_;
   build_section();
+  build_pull_rows();
   // A multiple of 4 KiB (512 doubles) plus 9 cache lines: the slots' starts fall on 19 (and the
   // force components' on 3) different cache-line offsets modulo 4 KiB and modulo any larger power
   // of two up to 9 * 64 lines, so a row's streams neither alias nor share cache sets.
@@ -544,6 +545,23 @@ void Lattice::build_section() {
     }
   }
   wall_buffer_.resize(wall_links_.size() * static_cast<std::size_t>(config_.nx));
+}
+
+void Lattice::build_pull_rows() {
+  const int ny = config_.ny, nz = config_.nz;
+  pull_rows_.resize(static_cast<std::size_t>(ny) * nz * kQ);
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int q = 0; q < kQ; ++q) {
+        std::int32_t& r = pull_rows_[(j + static_cast<std::size_t>(ny) * k) * kQ + q];
+        const int ks = k - kCz[q];
+        if (config_.walls && (ks < 0 || ks >= nz)) {
+          r = ks < 0 ? kPullBottomWall : kPullTopWall;
+          continue;
+        }
+        const int js = wrap(j - kCy[q], ny), kw = wrap(ks, nz);
+        r = solid_row(js, kw) ? kPullSolid : static_cast<std::int32_t>(js + ny * kw);
+      }
 }
 
 bool Lattice::is_solid(std::size_t node) const {
@@ -701,6 +719,31 @@ void Lattice::step_layers(int j0, int j1) {
 }
 
 void Lattice::populations(std::size_t node, double f[kQ]) const {
+  if (step_ % 2 == 0) {
+    for (int q = 0; q < kQ; ++q) f[q] = f_[q * stride_ + node];
+    return;
+  }
+  // populations_reference's cases, with the source row of each direction looked up.
+  const std::size_t nx = static_cast<std::size_t>(config_.nx);
+  const std::size_t row = node / nx;
+  const int i = static_cast<int>(node - row * nx);
+  const std::int32_t* source = pull_rows_.data() + row * kQ;
+  for (int q = 0; q < kQ; ++q) {
+    const std::int32_t r = source[q];
+    if (r >= 0) {
+      int is = i - kCx[q];
+      is = is < 0 ? is + config_.nx : (is >= config_.nx ? is - config_.nx : is);
+      f[q] = f_[opposite(q) * stride_ + static_cast<std::size_t>(r) * nx + static_cast<std::size_t>(is)];
+    } else if (r == kPullSolid) {
+      f[q] = f_[q * stride_ + node];
+    } else {
+      const double uw = r == kPullBottomWall ? -config_.wall_velocity : config_.wall_velocity;
+      f[q] = f_[q * stride_ + node] + 6.0 * kW[q] * kCx[q] * uw;
+    }
+  }
+}
+
+void Lattice::populations_reference(std::size_t node, double f[kQ]) const {
   if (step_ % 2 == 0) {
     for (int q = 0; q < kQ; ++q) f[q] = f_[q * stride_ + node];
     return;

@@ -3,6 +3,9 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <string>
+
+#include <omp.h>
 
 #include "bendlab/geometry/measures.hpp"
 
@@ -55,13 +58,27 @@ void LbmSuspension::restore(Lattice lattice, const Points& X) {
 void LbmSuspension::step() {
   const std::int64_t n = lattice_.step_count() + 1;
   try {
-    // 1. Forces at X(t).
-    for (const Cell& cell : cells_) {
-      const Eigen::Index rows = cell.membrane->num_vertices();
-      scratch_x_ = X_.middleRows(cell.first, rows);
-      cell.membrane->forces(scratch_x_, scratch_f_);
-      F_.middleRows(cell.first, rows) = scratch_f_;
+    // 1. Forces at X(t), a cell per thread (a membrane model is safe to share between threads);
+    // the first error is rethrown after the loop.
+    const int threads = cells_.size() > 1 ? omp_get_max_threads() : 1;
+    if (static_cast<int>(scratch_.size()) < threads) scratch_.resize(static_cast<std::size_t>(threads));
+    const auto cells = static_cast<std::ptrdiff_t>(cells_.size());
+    std::string failure;
+#pragma omp parallel for schedule(dynamic) num_threads(threads) if (threads > 1)
+    for (std::ptrdiff_t c = 0; c < cells; ++c) {
+      const Cell& cell = cells_[static_cast<std::size_t>(c)];
+      Scratch& s = scratch_[static_cast<std::size_t>(omp_get_thread_num())];
+      try {
+        const Eigen::Index rows = cell.membrane->num_vertices();
+        s.x = X_.middleRows(cell.first, rows);
+        cell.membrane->forces(s.x, s.f);
+        F_.middleRows(cell.first, rows) = s.f;
+      } catch (const Error& e) {
+#pragma omp critical
+        if (failure.empty()) failure = fmt::format("cell {}: {}", c, e.what());
+      }
     }
+    if (!failure.empty()) throw Error(failure);
     if (options_.vertex_force != Vec3::Zero()) F_.rowwise() += options_.vertex_force.transpose();
     cell_contact_energy_ = wall_contact_energy_ = 0;
     if (options_.cell_contact.max_force > 0 && cells_.size() > 1) {
@@ -74,9 +91,10 @@ void LbmSuspension::step() {
     }
     // 2-4, with the node velocities shared between overlapping stencils.
     lattice_.clear_force();
-    spread_forces(lattice_, X_, F_, options_.kernel);
+    interpolator_.prepare(lattice_, X_, options_.kernel);  // X's stencils, for 2 and 4
+    interpolator_.spread(lattice_, F_);
     lattice_.step();
-    interpolator_.interpolate(lattice_, X_, U_, options_.kernel);
+    interpolator_.interpolate(lattice_, U_);
     euler_move(X_, U_, 1.0);
   } catch (const Error& e) {
     throw Error(fmt::format("suspension step {}: {}", n, e.what()));

@@ -51,19 +51,36 @@ IbStencil ib_stencil(const std::array<int, 3>& n, bool walls, const Vec3& X, IbK
 void spread_forces(Lattice& lattice, const Points& X, const Points& F, IbKernel kernel = IbKernel::Phi2);
 /// U (resized to N x 3) = sum_x u(x) Phi(x - X_k), u = (sum f c + F/2) / rho.
 void interpolate_velocity(const Lattice& lattice, const Points& X, Points& U, IbKernel kernel = IbKernel::Phi2);
-/// interpolate_velocity for many nodes whose stencils overlap (the vertices of many cells): the
-/// fluid velocity of each lattice node is computed once per call and shared by every stencil that
-/// holds it, which a membrane with about one vertex per dx visits about four times. The sums are
-/// taken in the same order as interpolate_velocity's, so U equals its result bit for bit. Keeps a
-/// stamp and a velocity per lattice node (28 bytes) between calls; not for concurrent use.
+/// The immersed boundary of many nodes whose stencils overlap (the vertices of many cells), for a
+/// step in ESPResSo's order: prepare() takes the stencils of X once, spread() spreads the forces
+/// through them, and after the lattice's step interpolate() reads the fluid velocity of every
+/// lattice node in some stencil once (a membrane with about one vertex per dx visits each about
+/// four times), in the order of the nodes' indices, so that the 19 population arrays are read
+/// front to back, on OpenMP threads, and sums each node's stencil. Sums are taken in the same order
+/// as spread_forces' and interpolate_velocity's, so the forces and U equal theirs bit for bit.
+/// Keeps the stencils (16 bytes per entry, 8 entries per node with Phi2), a bit per lattice node
+/// and a velocity per lattice node (24 bytes) between calls; not for concurrent use.
 class IbInterpolator {
  public:
+  /// The stencils of X, kept until the next prepare. Throws as ib_stencil (a non-finite position,
+  /// a support across a wall), naming the node.
+  void prepare(const Lattice& lattice, const Points& X, IbKernel kernel = IbKernel::Phi2);
+  /// spread_forces through the prepared stencils; F has X's rows.
+  void spread(Lattice& lattice, const Points& F) const;
+  /// interpolate_velocity through the prepared stencils (after the lattice's step).
+  void interpolate(const Lattice& lattice, Points& U);
+  /// prepare(), then interpolate().
   void interpolate(const Lattice& lattice, const Points& X, Points& U, IbKernel kernel = IbKernel::Phi2);
 
  private:
-  std::vector<std::uint32_t> stamp_;
-  std::vector<double> velocity_;  // 3 per node
-  std::uint32_t current_ = 0;
+  int per_node_ = 0;                   // stencil entries per node (zero weights kept)
+  Eigen::Index nodes_ = 0;             // rows of the prepared X
+  std::size_t lattice_nodes_ = 0;      // of the lattice the stencils index
+  std::vector<std::size_t> node_;      // per_node_ entries per row of X
+  std::vector<double> weight_;
+  std::vector<std::uint64_t> marks_;   // a bit per lattice node: in some stencil
+  std::vector<std::size_t> touched_;   // the marked nodes, ascending
+  std::vector<double> velocity_;       // 3 per lattice node
 };
 
 /// X <- X + dt U.

@@ -171,8 +171,12 @@ class Lattice {
     for (std::int64_t s = 0; s < steps; ++s) step();
   }
 
-  /// The 19 post-stream populations of a node at the current step (layout-independent).
+  /// The 19 post-stream populations of a node at the current step (layout-independent). After an
+  /// odd step they sit at the neighbours; a table of each row's source rows finds them.
   void populations(std::size_t node, double f[kQ]) const;
+  /// The same from the node's coordinates, wall by wall: the reference populations() is tested
+  /// against, bit for bit.
+  void populations_reference(std::size_t node, double f[kQ]) const;
   double density(std::size_t node) const;
   /// u = (sum f c + F/2) / rho with the current force field (and the body force); zero at a node
   /// in the solid of the cross-section (the resting wall, which the immersed boundary then sees).
@@ -198,6 +202,8 @@ class Lattice {
   template <class Coll>
   void step_with(const Coll& coll, int j0, int j1);
   void build_section();
+  /// pull_rows_ (below).
+  void build_pull_rows();
   /// The interpolated bounce-back pass after a step (header comment); `after_odd` tells where the
   /// step left its populations.
   void apply_interpolated_bounce_back(bool after_odd, int j0, int j1);
@@ -223,6 +229,10 @@ class Lattice {
     int jb, kb;  // the row of x_f - c_q (periodic wrap)
   };
   std::vector<std::uint8_t> solid_rows_;
+  // Per row (j + ny k) and direction q, where f_q of its nodes comes from after an odd step: the
+  // source row (j - c_qy, k - c_qz wrapped), or one of the codes below (populations()).
+  static constexpr std::int32_t kPullSolid = -1, kPullBottomWall = -2, kPullTopWall = -3;
+  std::vector<std::int32_t> pull_rows_;
   std::vector<WallLink> wall_links_;
   std::vector<double> wall_buffer_;
   std::size_t fluid_nodes_ = 0;

@@ -14,6 +14,8 @@
 //      period (its vertices stay together: positions are unwrapped, the stencils and the contact
 //      search take the nearest image).
 // Blow-up: a non-finite position throws bendlab::Error naming the step, cell and vertex.
+// Threads: the cells' membrane forces (1) run a cell per OpenMP thread, the immersed boundary's
+// stencils and velocities on the threads too (IbInterpolator); results do not depend on the count.
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -88,7 +90,11 @@ class LbmSuspension {
   Lattice lattice_;
   std::vector<Cell> cells_;
   std::vector<int> cell_of_;
-  Points X_, F_, U_, scratch_x_, scratch_f_;
+  Points X_, F_, U_;
+  struct Scratch {
+    Points x, f;  // one cell's positions and forces
+  };
+  std::vector<Scratch> scratch_;  // per OpenMP thread
   ContactSearch contact_;
   IbInterpolator interpolator_;
   double cell_contact_energy_ = 0, wall_contact_energy_ = 0;
