@@ -39,6 +39,8 @@ void check_cell_kind(const CellKindSpec& s) {
           fmt::format("--bending-modulus {} J must be finite and not negative", s.bending_modulus));
   require(s.volume_modulus_ratio >= 0 && std::isfinite(s.volume_modulus_ratio),
           fmt::format("volume modulus ratio {} must be finite and not negative", s.volume_modulus_ratio));
+  // The bending method and its options, before any work ("none": no bending force).
+  if (s.method != "none") make_bending_method(s.method, parse_options(s.method_options));
 }
 
 CellKind make_cell_kind(const CellKindSpec& spec) {
@@ -73,7 +75,7 @@ std::shared_ptr<const MembraneModel> lattice_membrane(const CellKind& kind, cons
   p.elastic_law = s.elastic_law;
   p.skalak_c = s.skalak_c;
   p.kS = units.to_lattice_modulus(3.0 * s.shear_modulus);  // k_S = 3 G_s
-  p.kB = units.to_lattice_energy(s.bending_modulus);
+  p.kB = s.method == "none" ? 0.0 : units.to_lattice_energy(s.bending_modulus);
   if (p.kB > 0) p.bending = make_bending_method(s.method, parse_options(s.method_options));
   if (s.volume_modulus_ratio > 0) {
     // kappa_V = ratio kS / R: the capsule runs' kappa_V = 100 kS in units of the cell's radius

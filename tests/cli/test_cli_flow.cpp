@@ -61,6 +61,7 @@ TEST_F(Cli, FlowRefusesBadInputWithOneLineBeforeWork) {
                      out.string()),
                  "--width", out);
   expect_refused(run("flow --hematocrit 0 --diameter 10 --length 10 --out " + out.string()), "driving", out);
+  expect_refused(run("flow --hematocrit 0 --method M --option degree=9" + tube), "degree", out);
 }
 
 TEST_F(Cli, FlowWarnsOfAMeshCoarserThanTheLattice) {

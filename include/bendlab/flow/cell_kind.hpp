@@ -30,13 +30,14 @@ struct CellKindSpec {
   double shear_modulus = 5.3e-6;      ///< G_s, N/m (k_S = 3 G_s, docs/conventions.md §2)
   double skalak_c = 10;               ///< the Skalak law's C (area modulus G_s (1 + 2 C))
   double bending_modulus = 2e-19;     ///< kappa_B, J
-  std::string method = "C";           ///< bending method
+  std::string method = "C";           ///< bending method ("none": no bending force)
   std::vector<std::string> method_options;  ///< name=value
   double volume_modulus_ratio = 100;  ///< kappa_V R / kappa_S of ESPResSo's volume force (R the radius)
 };
 
 /// Throws bendlab::Error, naming the option, for an unknown shape or law, a non-positive or
-/// non-finite radius or modulus, a negative bending modulus, C <= -1/2.
+/// non-finite radius or modulus, a negative bending modulus, C <= -1/2, an unknown bending method
+/// or options it refuses.
 void check_cell_kind(const CellKindSpec& spec);
 
 struct CellKind {
