@@ -12,6 +12,14 @@
 //                        26 (1 rank) and 48 (2 ranks) steps/s on this kind of machine;
 //   BM_PipeflowFluid     the fluid step alone (the same lattice, no cells): cells_fraction of the
 //                        whole step = 1 - fluid / step, computed by scripts from the two.
+//   BM_PipeflowHt03Step  the same tube at tube hematocrit 0.3 (red blood cells only, placed by
+//                        place_cells from seed 1 with the same clearance: about 80 cells).
+//   BM_ExtraCellMemory   the resident memory a suspension grows by per red blood cell added to the
+//                        pipeflow case (20 more, stepped twice so that every per-vertex array has
+//                        grown): bytes_per_cell and bytes_per_vertex, against positions and forces
+//                        alone (48 bytes per vertex). Timed is nothing; its counters are the figure.
+#include <fstream>
+#include <unistd.h>
 #include <benchmark/benchmark.h>
 #include <omp.h>
 
@@ -38,7 +46,15 @@ FlowUnits pipeflow_units() {
   return flow_units(in);
 }
 
-std::unique_ptr<LbmSuspension> pipeflow(bool with_cells) {
+// The resident set size of the process, bytes (/proc/self/statm).
+double resident_bytes() {
+  std::ifstream statm("/proc/self/statm");
+  double pages = 0, resident = 0;
+  statm >> pages >> resident;
+  return resident * static_cast<double>(sysconf(_SC_PAGESIZE));
+}
+
+std::unique_ptr<LbmSuspension> pipeflow(bool with_cells, double hematocrit = 0) {
   const FlowUnits u = pipeflow_units();
   SuspensionOptions o;
   o.lattice = flow_lattice_config(u);
@@ -57,13 +73,18 @@ std::unique_ptr<LbmSuspension> pipeflow(bool with_cells) {
   const CellKind stiff = make_cell_kind(small);
   const Vessel tube_um = Vessel::tube(25, 50);
   PlacementOptions p;
-  p.count = 36;
+  if (hematocrit > 0) {
+    p.hematocrit = hematocrit;
+  } else {
+    p.count = 36;
+  }
   p.clearance = 0.25;
   p.seed = 1;
   const Placement reds = place_cells(tube_um, rbc.reference_um.topology(), rbc.reference_um.positions(), p);
   const auto red_membrane = lattice_membrane(rbc, u);
   const auto stiff_membrane = lattice_membrane(stiff, u);
   for (const PlacedCell& c : reds.cells) s->add_cell(red_membrane, placed_positions(rbc.reference_um.positions(), c) / u.input.dx_um);
+  if (hematocrit > 0) return s;
   // The small cells where the red ones leave room: placed among them by trying positions.
   int added = 0;
   for (int k = 0; k < 400 && added < 6; ++k) {
@@ -106,8 +127,42 @@ void BM_PipeflowFluid(benchmark::State& state) {
                                                benchmark::Counter::kIsRate);
 }
 
+void BM_PipeflowHt03Step(benchmark::State& state) {
+  omp_set_num_threads(static_cast<int>(state.range(0)));
+  static std::unique_ptr<LbmSuspension> s = pipeflow(true, 0.3);
+  s->run(2);
+  for (auto _ : state) s->step();
+  state.counters["steps_per_second"] = benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["cells"] = s->num_cells();
+  state.counters["vertices"] = static_cast<double>(s->positions().rows());
+}
+
+void BM_ExtraCellMemory(benchmark::State& state) {
+  omp_set_num_threads(1);
+  std::unique_ptr<LbmSuspension> s = pipeflow(true);
+  s->run(2);
+  const double before = resident_bytes();
+  const int first_red = 0, extra = 20;
+  const Points red = s->cell_positions(first_red);
+  // Copies of the first cell shifted along the axis by a period: where it is, so that the run
+  // stays finite (their contact forces are capped); the memory is what is measured.
+  const std::shared_ptr<const MembraneModel> membrane(std::shared_ptr<const MembraneModel>(), &s->membrane(first_red));
+  for (int k = 0; k < extra; ++k) {
+    Points x = red;
+    x.col(0).array() += s->lattice().nx() * (k + 1);
+    s->add_cell(membrane, x);
+  }
+  s->run(2);
+  const double after = resident_bytes();
+  for (auto _ : state) benchmark::DoNotOptimize(after);
+  state.counters["bytes_per_cell"] = (after - before) / extra;
+  state.counters["bytes_per_vertex"] = (after - before) / (extra * static_cast<double>(red.rows()));
+}
+
 }  // namespace
 
 BENCHMARK(BM_PipeflowFluid)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_PipeflowStep)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_PipeflowHt03Step)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ExtraCellMemory)->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK_MAIN();
