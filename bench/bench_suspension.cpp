@@ -14,12 +14,11 @@
 //                        whole step = 1 - fluid / step, computed by scripts from the two.
 //   BM_PipeflowHt03Step  the same tube at tube hematocrit 0.3 (red blood cells only, placed by
 //                        place_cells from seed 1 with the same clearance: about 80 cells).
-//   BM_ExtraCellMemory   the resident memory a suspension grows by per red blood cell added to the
+//   BM_ExtraCellMemory   the heap a suspension grows by per red blood cell added to the
 //                        pipeflow case (20 more, stepped twice so that every per-vertex array has
 //                        grown): bytes_per_cell and bytes_per_vertex, against positions and forces
 //                        alone (48 bytes per vertex). Timed is nothing; its counters are the figure.
-#include <fstream>
-#include <unistd.h>
+#include <malloc.h>
 #include <benchmark/benchmark.h>
 #include <omp.h>
 
@@ -46,12 +45,11 @@ FlowUnits pipeflow_units() {
   return flow_units(in);
 }
 
-// The resident set size of the process, bytes (/proc/self/statm).
-double resident_bytes() {
-  std::ifstream statm("/proc/self/statm");
-  double pages = 0, resident = 0;
-  statm >> pages >> resident;
-  return resident * static_cast<double>(sysconf(_SC_PAGESIZE));
+// The heap the process has in use, bytes (glibc's mallinfo2: allocated blocks, mapped ones
+// included; blocks freed but kept by the allocator are not counted, as the resident set would).
+double heap_in_use() {
+  const struct mallinfo2 m = mallinfo2();
+  return static_cast<double>(m.uordblks) + static_cast<double>(m.hblkhd);
 }
 
 std::unique_ptr<LbmSuspension> pipeflow(bool with_cells, double hematocrit = 0) {
@@ -155,7 +153,7 @@ void BM_ExtraCellMemory(benchmark::State& state) {
   omp_set_num_threads(1);
   std::unique_ptr<LbmSuspension> s = pipeflow(true);
   s->run(2);
-  const double before = resident_bytes();
+  const double before = heap_in_use();
   const int first_red = 0, extra = 20;
   const Points red = s->cell_positions(first_red);
   // Copies of the first cell shifted along the axis by a period: where it is, so that the run
@@ -167,7 +165,7 @@ void BM_ExtraCellMemory(benchmark::State& state) {
     s->add_cell(membrane, x);
   }
   s->run(2);
-  const double after = resident_bytes();
+  const double after = heap_in_use();
   for (auto _ : state) benchmark::DoNotOptimize(after);
   state.counters["bytes_per_cell"] = (after - before) / extra;
   state.counters["bytes_per_vertex"] = (after - before) / (extra * static_cast<double>(red.rows()));
