@@ -41,3 +41,12 @@ def test_progress_reports_the_recorders_measures(tmp_path):
     bendlab.flow_run(tmp_path / "r", progress=seen.append, progress_interval=0, **SMALL)
     assert seen and seen[-1]["final"]
     assert {"eta_app", "H_D", "CFL_um"} <= set(seen[-1])
+
+
+def test_the_shear_box_without_cells_has_the_plasma_viscosity(tmp_path):
+    summary = bendlab.flow_run(tmp_path / "r", geometry="shear", height=4, width=3, length=3, shear_rate=2000,
+                               hematocrit=0, t_end=4e-6, sample_every=1e-6)
+    assert summary["apparent_viscosity"]["mean"] == pytest.approx(1.0, abs=1e-12)
+    assert summary["discharge_hematocrit"]["mean"] is None
+    with pytest.raises(ValueError, match="shear-rate"):
+        bendlab.flow_run(tmp_path / "q", geometry="shear", height=4, width=3, length=3, hematocrit=0, t_end=4e-6)
