@@ -48,7 +48,7 @@ from study_runner import ROOT, fmt_g  # noqa: E402
 DX = 0.5
 TAU = 1.82
 PSEUDO_SHEAR_RATE = 100.0
-T_END = 0.03
+T_END = 0.1
 SEED = 1
 SAMPLE_EVERY = 1e-4
 SNAPSHOT_EVERY = 0.01
