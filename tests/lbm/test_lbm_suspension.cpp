@@ -206,3 +206,34 @@ TEST(LbmSuspension, ThreadCountDoesNotChangeTheRun) {
   const Points one = run(1), two = run(2);
   EXPECT_EQ(one, two);
 }
+
+// The shear box's moving walls repel as a channel's resting ones do: a cell pushed towards the top
+// wall comes to rest on the repulsion, no vertex crosses the wall, and the immersed boundary's
+// kernel never reaches it (which the lattice would refuse).
+TEST(LbmSuspension, CellPressedOntoAMovingWallNeverCrossesIt) {
+  SuspensionOptions o;
+  o.lattice.nx = 24;
+  o.lattice.ny = 16;
+  o.lattice.nz = 18;
+  o.lattice.tau = 1.0;
+  o.lattice.walls = true;
+  o.lattice.wall_velocity = 0.02;
+  o.vessel = Vessel::box(18, 16, 24);
+  o.wall_contact = ContactLaw{0.05, 2.0};
+  o.vertex_force = Vec3(0, 0, 1e-3);
+  LbmSuspension s(o);
+  s.lattice().initialise_shear_flow();
+  const auto m = rbc(4.0, 0.01);
+  s.add_cell(m, moved(m->reference_positions(), Vec3(0, 0, 5.0)));
+  double nearest = 1e9;
+  for (int check = 0; check < 30; ++check) {
+    ASSERT_NO_THROW(s.run(20)) << "step " << s.steps();
+    for (Eigen::Index k = 0; k < s.positions().rows(); ++k) {
+      const double d = s.options().vessel.wall_distance(row(s.positions(), k));
+      ASSERT_GT(d, 1.0) << "vertex " << k << " within the kernel's reach of the wall at step " << s.steps();
+      nearest = std::min(nearest, d);
+    }
+  }
+  EXPECT_LT(nearest, 2.0) << "the cell never reached the wall's contact zone";
+  EXPECT_GT(s.wall_contact_energy(), 0.0);
+}
