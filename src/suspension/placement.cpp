@@ -9,19 +9,17 @@
 
 #include "bendlab/geometry/point_in_mesh.hpp"
 #include "bendlab/mesh/enclosed_volume.hpp"
+#include "bendlab/suspension/placement_growth.hpp"
+#include "placement_checks.hpp"
 
 namespace bendlab {
 
 namespace {
-
-// Shoemake's uniform random rotation.
-Mat3 random_rotation(std::mt19937_64& rng) {
-  std::uniform_real_distribution<double> u(0.0, 1.0);
-  const double u1 = u(rng), u2 = 2 * std::numbers::pi * u(rng), u3 = 2 * std::numbers::pi * u(rng);
-  const Eigen::Quaterniond q(std::sqrt(u1) * std::cos(u3), std::sqrt(1 - u1) * std::sin(u2), std::sqrt(1 - u1) * std::cos(u2),
-                             std::sqrt(u1) * std::sin(u3));
-  return q.normalized().toRotationMatrix();
-}
+constexpr double kGrowableFraction = 0.65;
+using placement_detail::Candidate;
+using placement_detail::apart;
+using placement_detail::clear_of_wall;
+using placement_detail::random_rotation;
 
 // The reference z axis turned onto x, spun about it and tilted by up to `max_tilt`.
 Mat3 aligned_rotation(std::mt19937_64& rng, double max_tilt) {
@@ -53,42 +51,6 @@ double widest_gap_middle(const std::vector<double>& xs, double length, double& g
     }
   }
   return middle;
-}
-
-struct Candidate {
-  Points x;
-  BoundingBox box;
-  Vec3 centre;
-};
-
-bool clear_of_wall(const Vessel& v, const Points& x, double clearance) {
-  for (Eigen::Index i = 0; i < x.rows(); ++i) {
-    if (v.wall_distance(row(x, i)) < clearance) return false;
-  }
-  return true;
-}
-
-// Whether cells a and b (b shifted by `shift`, a periodic image) keep the clearance and neither
-// holds a vertex of the other.
-bool apart(const Topology& topo, const Candidate& a, const Candidate& b, const Vec3& shift, double clearance) {
-  Points bx = b.x;
-  bx.rowwise() += shift.transpose();
-  BoundingBox bb{b.box.lo + shift, b.box.hi + shift};
-  // Boxes farther apart than the clearance: nothing to check.
-  if (((a.box.lo.array() - bb.hi.array()) >= clearance).any() || ((bb.lo.array() - a.box.hi.array()) >= clearance).any()) return true;
-  const double c2 = clearance * clearance;
-  for (Eigen::Index i = 0; i < a.x.rows(); ++i) {
-    const Vec3 p = row(a.x, i);
-    if (!bb.contains(p, clearance)) continue;
-    for (Eigen::Index j = 0; j < bx.rows(); ++j) {
-      if ((p - row(bx, j)).squaredNorm() < c2) return false;
-    }
-    if (contains(topo, bx, bb, p)) return false;
-  }
-  for (Eigen::Index j = 0; j < bx.rows(); ++j) {
-    if (contains(topo, a.x, a.box, row(bx, j))) return false;
-  }
-  return true;
 }
 
 }  // namespace
@@ -132,6 +94,15 @@ Placement place_cells(const Vessel& vessel, const Topology& topo, const Points& 
   const bool narrow = vessel.kind() == VesselKind::Tube && half_width < 2 * extent;
   const double x0 = u(rng) * vessel.length();
   const Vec3 period = vessel.period();
+  // The room a stacked cell has to tilt and shift in its slot: a disc of thickness h and diameter
+  // d tilted by theta spans about h + d sin(theta) along the axis, so the largest tilt (and the
+  // jitter with it) is scaled to what the slot leaves, sin(theta) <= (slot - clearance - h) / d.
+  double narrow_freedom = 1.0;
+  if (narrow && target > 0) {
+    const double slot = vessel.length() / target;
+    const double thickness = reference.col(2).maxCoeff() - reference.col(2).minCoeff();
+    narrow_freedom = std::clamp((slot - o.clearance - thickness) / (2 * extent) / std::sin(std::numbers::pi / 6), 0.0, 1.0);
+  }
   for (int c = 0; c < target; ++c) {
     bool ok = false;
     for (int attempt = 0; attempt < o.attempts_per_cell && !ok; ++attempt) {
@@ -139,7 +110,7 @@ Placement place_cells(const Vessel& vessel, const Topology& topo, const Points& 
       const bool aligned = narrow || attempt >= o.attempts_per_cell / 2;
       // In a narrow tube the tilt and the jitter shrink as the attempts go by, down to a cell
       // square to the axis in the middle of its slot.
-      const double freedom = narrow ? 1.0 - static_cast<double>(attempt) / o.attempts_per_cell : 1.0;
+      const double freedom = narrow ? narrow_freedom * (1.0 - static_cast<double>(attempt) / o.attempts_per_cell) : 1.0;
       const Mat3 R = aligned ? aligned_rotation(rng, freedom * std::numbers::pi / 6) : random_rotation(rng);
       Vec3 centre(u(rng) * vessel.length(), u(rng) * vessel.width(), u(rng) * vessel.height());
       if (narrow) {
@@ -186,10 +157,24 @@ Placement place_cells(const Vessel& vessel, const Topology& topo, const Points& 
       }
     }
     if (!ok) {
+      // Jammed: every cell again, shrunk and grown (placement_growth.hpp), where a packing can
+      // hold the target at all (random packings of discs and ellipsoids stay below 0.7) and
+      // where a cell fitted (the first did).
+      const double fraction = target * result.cell_volume / vessel.volume();
+      auto grown = fraction <= kGrowableFraction && !placed.empty()
+                       ? grow_cells(vessel, topo, reference, target, o.clearance, o.seed)
+                       : std::nullopt;
+      if (grown) {
+        result.cells = std::move(*grown);
+        result.grown = true;
+        break;
+      }
       const double best = static_cast<double>(placed.size()) * result.cell_volume / vessel.volume();
-      throw Error(fmt::format("cannot place {} cells (H_T {:.4f}) in the {}: {} placed (H_T {:.4f}) before cell {} failed {} attempts",
+      throw Error(fmt::format("cannot place {} cells (H_T {:.4f}) in the {}: {} placed (H_T {:.4f}) before cell {} failed {} "
+                              "attempts, and growing them from a smaller size did not reach full size{}",
                               target, target * result.cell_volume / vessel.volume(), vessel.describe(), placed.size(), best,
-                              c + 1, o.attempts_per_cell));
+                              c + 1, o.attempts_per_cell,
+                              fraction > kGrowableFraction ? " (not tried above a volume fraction of 0.65)" : ""));
     }
   }
   result.hematocrit = static_cast<double>(result.cells.size()) * result.cell_volume / vessel.volume();

@@ -18,8 +18,10 @@
 // cell c goes to the slot x0 + (c + 1/2) L / N (x0 from the seed): random orientations and
 // positions there leave gaps no later cell fits into. Its tilt (up to 30 degrees), its offset from
 // the axis and its jitter in the slot (up to half a slot) shrink linearly over the attempts, down to
-// a cell square to the axis in the middle of its slot. A target that cannot be placed within the attempts is refused with an Error that
-// states the best reached; nothing is returned half-placed.
+// a cell square to the axis in the middle of its slot. Where a cell finds no room within its
+// attempts, every cell is placed again by growth (placement_growth.hpp: shrunk, placed, grown to
+// full size as rigid bodies pushed apart, then checked exactly as here). A target that neither
+// reaches is refused with an Error that states the best reached; nothing is returned half-placed.
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -48,6 +50,7 @@ struct Placement {
   double hematocrit = 0;  ///< achieved: cells x cell volume / vessel volume
   double cell_volume = 0;
   std::int64_t attempts = 0;
+  bool grown = false;     ///< placed by growth (placement_growth.hpp) after the random addition jammed
 };
 
 /// The reference shape (topology, reference: vertex positions with the volume centroid at the
