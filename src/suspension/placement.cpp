@@ -92,6 +92,8 @@ Placement place_cells(const Vessel& vessel, const Topology& topo, const Points& 
   // A tube less than two cell diameters across holds its cells stacked along the axis, as red
   // blood cells go through capillaries: every attempt aligns the cell with the flow.
   const bool narrow = vessel.kind() == VesselKind::Tube && half_width < 2 * extent;
+  const BoundingBox frame_box = bounding_box(reference);
+  const double slack = 1e-9 * extent;
   const double x0 = u(rng) * vessel.length();
   const Vec3 period = vessel.period();
   // The room a stacked cell has to tilt and shift in its slot: a disc of thickness h and diameter
@@ -133,7 +135,7 @@ Placement place_cells(const Vessel& vessel, const Topology& topo, const Points& 
           centre.z() = 2 * reach * u(rng);
         }
       }
-      Candidate cand{placed_positions(reference, PlacedCell{R, centre}), {}, centre};
+      Candidate cand{placed_positions(reference, PlacedCell{R, centre}), {}, centre, R};
       if (!clear_of_wall(vessel, cand.x, o.clearance)) continue;
       cand.box = bounding_box(cand.x);
       ok = true;
@@ -145,7 +147,7 @@ Placement place_cells(const Vessel& vessel, const Topology& topo, const Points& 
           for (int sy = vessel.periodic(1) ? -1 : 0; sy <= (vessel.periodic(1) ? 1 : 0) && ok; ++sy) {
             const Vec3 shift = d + Vec3(sx * period.x(), sy * period.y(), 0);
             if ((other.centre + shift - cand.centre).norm() > 2 * extent + o.clearance) continue;
-            ok = apart(topo, cand, other, shift, o.clearance);
+            ok = apart(topo, cand, other, shift, o.clearance, frame_box, slack);
           }
         }
         if (!ok) break;

@@ -20,23 +20,29 @@ bool clear_of_wall(const Vessel& v, const Points& x, double clearance) {
   return true;
 }
 
-bool apart(const Topology& topo, const Candidate& a, const Candidate& b, const Vec3& shift, double clearance) {
+bool apart(const Topology& topo, const Candidate& a, const Candidate& b, const Vec3& shift, double clearance,
+           const BoundingBox& frame_box, double slack) {
   Points bx = b.x;
   bx.rowwise() += shift.transpose();
   BoundingBox bb{b.box.lo + shift, b.box.hi + shift};
   // Boxes farther apart than the clearance: nothing to check.
   if (((a.box.lo.array() - bb.hi.array()) >= clearance).any() || ((bb.lo.array() - a.box.hi.array()) >= clearance).any()) return true;
   const double c2 = clearance * clearance;
+  const Vec3 b_centre = b.centre + shift;
   for (Eigen::Index i = 0; i < a.x.rows(); ++i) {
     const Vec3 p = row(a.x, i);
     if (!bb.contains(p, clearance)) continue;
+    const Vec3 q = b.rotation.transpose() * (p - b_centre);
+    if (!frame_box.contains(q, clearance + slack)) continue;
     for (Eigen::Index j = 0; j < bx.rows(); ++j) {
       if ((p - row(bx, j)).squaredNorm() < c2) return false;
     }
-    if (contains(topo, bx, bb, p)) return false;
+    if (frame_box.contains(q, slack) && contains(topo, bx, bb, p)) return false;
   }
   for (Eigen::Index j = 0; j < bx.rows(); ++j) {
-    if (contains(topo, a.x, a.box, row(bx, j))) return false;
+    const Vec3 p = row(bx, j);
+    if (!frame_box.contains(a.rotation.transpose() * (p - a.centre), slack)) continue;
+    if (contains(topo, a.x, a.box, p)) return false;
   }
   return true;
 }

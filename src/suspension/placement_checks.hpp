@@ -14,6 +14,7 @@ struct Candidate {
   Points x;
   BoundingBox box;
   Vec3 centre;
+  Mat3 rotation = Mat3::Identity();  ///< x = reference rotation^T + centre
 };
 
 /// Shoemake's uniform random rotation.
@@ -23,7 +24,11 @@ Mat3 random_rotation(std::mt19937_64& rng);
 bool clear_of_wall(const Vessel& v, const Points& x, double clearance);
 
 /// Whether cells a and b (b shifted by `shift`, a periodic image) keep the clearance and neither
-/// holds a vertex of the other.
-bool apart(const Topology& topo, const Candidate& a, const Candidate& b, const Vec3& shift, double clearance);
+/// holds a vertex of the other. A vertex is first set against the other cell's box in that cell's
+/// own frame (`frame_box`, the reference's box, widened by `slack` against rounding): outside it,
+/// widened by the clearance, it is near none of the other's vertices, and outside it, inside none
+/// of it, so the tests it skips could not fail and the answer is the same.
+bool apart(const Topology& topo, const Candidate& a, const Candidate& b, const Vec3& shift, double clearance,
+           const BoundingBox& frame_box, double slack);
 
 }  // namespace bendlab::placement_detail

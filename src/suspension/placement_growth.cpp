@@ -44,6 +44,8 @@ std::optional<std::vector<Body>> place_shrunk(const Vessel& vessel, const Topolo
   double extent = 0;
   for (Eigen::Index i = 0; i < shrunk.rows(); ++i) extent = std::max(extent, shrunk.row(i).norm());
   const Vec3 period = vessel.period();
+  const BoundingBox frame_box = bounding_box(shrunk);
+  const double slack = 1e-9 * extent;
   std::vector<Body> bodies;
   std::vector<Candidate> placed;
   for (int c = 0; c < count; ++c) {
@@ -51,7 +53,7 @@ std::optional<std::vector<Body>> place_shrunk(const Vessel& vessel, const Topolo
     for (int attempt = 0; attempt < kAttemptsPerCell && !ok; ++attempt) {
       const Mat3 R = random_rotation(rng);
       const Vec3 centre(u(rng) * vessel.length(), u(rng) * vessel.width(), u(rng) * vessel.height());
-      Candidate cand{shrunk * R.transpose(), {}, centre};
+      Candidate cand{shrunk * R.transpose(), {}, centre, R};
       cand.x.rowwise() += centre.transpose();
       if (!clear_of_wall(vessel, cand.x, clearance)) continue;
       cand.box = bounding_box(cand.x);
@@ -62,7 +64,7 @@ std::optional<std::vector<Body>> place_shrunk(const Vessel& vessel, const Topolo
           for (int sy = vessel.periodic(1) ? -1 : 0; sy <= (vessel.periodic(1) ? 1 : 0) && ok; ++sy) {
             const Vec3 shift = d + Vec3(sx * period.x(), sy * period.y(), 0);
             if ((other.centre + shift - cand.centre).norm() > 2 * extent + clearance) continue;
-            ok = apart(topo, cand, other, shift, clearance);
+            ok = apart(topo, cand, other, shift, clearance, frame_box, slack);
           }
         if (!ok) break;
       }
@@ -129,9 +131,11 @@ bool all_apart(const Vessel& vessel, const Topology& topo, const Points& referen
   double extent = 0;
   for (Eigen::Index i = 0; i < reference.rows(); ++i) extent = std::max(extent, reference.row(i).norm());
   const Vec3 period = vessel.period();
+  const BoundingBox frame_box = bounding_box(reference);
+  const double slack = 1e-9 * extent;
   std::vector<Candidate> cells;
   for (const Body& b : bodies) {
-    Candidate c{reference * b.rotation.transpose(), {}, b.centre};
+    Candidate c{reference * b.rotation.transpose(), {}, b.centre, b.rotation};
     c.x.rowwise() += b.centre.transpose();
     if (!clear_of_wall(vessel, c.x, clearance)) return false;
     c.box = bounding_box(c.x);
@@ -144,7 +148,7 @@ bool all_apart(const Vessel& vessel, const Topology& topo, const Points& referen
         for (int sy = vessel.periodic(1) ? -1 : 0; sy <= (vessel.periodic(1) ? 1 : 0); ++sy) {
           const Vec3 shift = d + Vec3(sx * period.x(), sy * period.y(), 0);
           if ((cells[b].centre + shift - cells[a].centre).norm() > 2 * extent + clearance) continue;
-          if (!apart(topo, cells[a], cells[b], shift, clearance)) return false;
+          if (!apart(topo, cells[a], cells[b], shift, clearance, frame_box, slack)) return false;
         }
     }
   return true;
