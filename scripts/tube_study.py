@@ -4,7 +4,8 @@ Pries et al., and what the bending algorithm changes (`bendlab flow` runs; issue
 tube").
 
     /usr/bin/python3 scripts/tube_study.py [--only diameters|hematocrit|methods|resolution|doc]
-                                           [--t-end S] [--jobs N] [--bendlab PATH] [--work DIR]
+                                           [--t-end S] [--jobs N] [--methods LIST] [--bendlab PATH]
+                                           [--work DIR]
                                            [--doc FILE] [--list]
 
 Parts (each run one `bendlab flow` process):
@@ -118,9 +119,9 @@ def run(D, H, method="C", mesh="mt1:1280", t_end=T_END):
     return Run(name, D, H, method, mesh, t_end)
 
 
-def parts(t_end):
+def parts(t_end, methods=METHODS):
     return {
-        "methods": [run(10, 0.3, m, t_end=t_end) for m in METHODS],
+        "methods": [run(10, 0.3, m, t_end=t_end) for m in methods],
         "diameters": [run(D, 0.3, t_end=t_end) for D in (10, 15, 20)],
         "hematocrit": [run(10, H, t_end=t_end) for H in (0.2, 0.4)],
         "resolution": [run(10, 0.3, "C", "mt1:5120", t_end=t_end)],
@@ -363,6 +364,8 @@ def main():
     p.add_argument("--only", choices=["methods", "diameters", "hematocrit", "resolution", "doc"], default=None)
     p.add_argument("--t-end", type=float, default=T_END, help="end of every run, s")
     p.add_argument("--jobs", type=int, default=1)
+    p.add_argument("--methods", default=",".join(METHODS),
+                   help="the bending methods of part methods, in the order they run (default: all)")
     p.add_argument("--bendlab", default=str(ROOT / "build" / "release" / "bendlab"))
     p.add_argument("--work", default=str(ROOT / "studies" / "tube"))
     p.add_argument("--doc", default=str(ROOT / "docs" / "results" / "tube_flow.md"))
@@ -370,7 +373,7 @@ def main():
     a = p.parse_args()
     work, doc = Path(a.work), Path(a.doc)
     work.mkdir(parents=True, exist_ok=True)
-    all_parts = parts(a.t_end)
+    all_parts = parts(a.t_end, [m for m in a.methods.split(",") if m])
     order = ["methods", "diameters", "hematocrit", "resolution"]
     todo = [] if a.only == "doc" else (all_parts[a.only] if a.only else [r for k in order for r in all_parts[k]])
     if a.list:
