@@ -59,6 +59,7 @@ struct Candidate {
   Points x;
   BoundingBox box;
   Vec3 centre;
+  Mat3 rotation;
 };
 
 bool clear_of_wall(const Vessel& v, const Points& x, double clearance) {
@@ -69,24 +70,33 @@ bool clear_of_wall(const Vessel& v, const Points& x, double clearance) {
 }
 
 // Whether cells a and b (b shifted by `shift`, a periodic image) keep the clearance and neither
-// holds a vertex of the other.
-bool apart(const Topology& topo, const Candidate& a, const Candidate& b, const Vec3& shift, double clearance) {
+// holds a vertex of the other. A vertex is first set against the other cell's box in that cell's
+// own frame (`frame_box`, the reference's box, widened by `slack` against rounding): outside it,
+// widened by the clearance, it is near none of the other's vertices, and outside it, inside
+// none of it, so the tests it skips could not fail and the answer is the same.
+bool apart(const Topology& topo, const Candidate& a, const Candidate& b, const Vec3& shift, double clearance,
+           const BoundingBox& frame_box, double slack) {
   Points bx = b.x;
   bx.rowwise() += shift.transpose();
   BoundingBox bb{b.box.lo + shift, b.box.hi + shift};
   // Boxes farther apart than the clearance: nothing to check.
   if (((a.box.lo.array() - bb.hi.array()) >= clearance).any() || ((bb.lo.array() - a.box.hi.array()) >= clearance).any()) return true;
   const double c2 = clearance * clearance;
+  const Vec3 b_centre = b.centre + shift;
   for (Eigen::Index i = 0; i < a.x.rows(); ++i) {
     const Vec3 p = row(a.x, i);
     if (!bb.contains(p, clearance)) continue;
+    const Vec3 q = b.rotation.transpose() * (p - b_centre);
+    if (!frame_box.contains(q, clearance + slack)) continue;
     for (Eigen::Index j = 0; j < bx.rows(); ++j) {
       if ((p - row(bx, j)).squaredNorm() < c2) return false;
     }
-    if (contains(topo, bx, bb, p)) return false;
+    if (frame_box.contains(q, slack) && contains(topo, bx, bb, p)) return false;
   }
   for (Eigen::Index j = 0; j < bx.rows(); ++j) {
-    if (contains(topo, a.x, a.box, row(bx, j))) return false;
+    const Vec3 p = row(bx, j);
+    if (!frame_box.contains(a.rotation.transpose() * (p - a.centre), slack)) continue;
+    if (contains(topo, a.x, a.box, p)) return false;
   }
   return true;
 }
@@ -130,6 +140,8 @@ Placement place_cells(const Vessel& vessel, const Topology& topo, const Points& 
   // A tube less than two cell diameters across holds its cells stacked along the axis, as red
   // blood cells go through capillaries: every attempt aligns the cell with the flow.
   const bool narrow = vessel.kind() == VesselKind::Tube && half_width < 2 * extent;
+  const BoundingBox frame_box = bounding_box(reference);
+  const double slack = 1e-9 * extent;
   const double x0 = u(rng) * vessel.length();
   const Vec3 period = vessel.period();
   for (int c = 0; c < target; ++c) {
@@ -162,7 +174,7 @@ Placement place_cells(const Vessel& vessel, const Topology& topo, const Points& 
           centre.z() = 2 * reach * u(rng);
         }
       }
-      Candidate cand{placed_positions(reference, PlacedCell{R, centre}), {}, centre};
+      Candidate cand{placed_positions(reference, PlacedCell{R, centre}), {}, centre, R};
       if (!clear_of_wall(vessel, cand.x, o.clearance)) continue;
       cand.box = bounding_box(cand.x);
       ok = true;
@@ -174,7 +186,7 @@ Placement place_cells(const Vessel& vessel, const Topology& topo, const Points& 
           for (int sy = vessel.periodic(1) ? -1 : 0; sy <= (vessel.periodic(1) ? 1 : 0) && ok; ++sy) {
             const Vec3 shift = d + Vec3(sx * period.x(), sy * period.y(), 0);
             if ((other.centre + shift - cand.centre).norm() > 2 * extent + o.clearance) continue;
-            ok = apart(topo, cand, other, shift, o.clearance);
+            ok = apart(topo, cand, other, shift, o.clearance, frame_box, slack);
           }
         }
         if (!ok) break;
