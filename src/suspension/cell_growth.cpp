@@ -427,7 +427,7 @@ GrowthResult grow_cells(const Vessel& vessel, const Topology& topology, const Po
   if (!cleared) return result;
   cells = trial;
   double s = o.initial_scale, step = 0.05;
-  const double max_step = 0.05, min_step = 1e-3;
+  const double max_step = 0.05, min_step = 2.5e-3;
   while (s < 1) {
     const double next = std::min(1.0, s + step);
     trial = cells;

@@ -47,7 +47,7 @@ TEST(MeshDistance, EqualsTheNearestTriangleAndKnowsInsideFromOutside) {
   std::mt19937_64 rng(3);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   int near = 0, inside = 0;
-  for (int k = 0; k < 3000; ++k) {
+  for (int k = 0; k < 1500; ++k) {
     Vec3 p;
     for (int d = 0; d < 3; ++d) p[d] = box.lo[d] - 1.0 + (box.hi[d] - box.lo[d] + 2.0) * u(rng);
     double exact = std::numeric_limits<double>::infinity();
@@ -67,6 +67,6 @@ TEST(MeshDistance, EqualsTheNearestTriangleAndKnowsInsideFromOutside) {
       EXPECT_FALSE(found) << "point " << k << " at " << exact;
     }
   }
-  EXPECT_GT(near, 300);
-  EXPECT_GT(inside, 50);
+  EXPECT_GT(near, 150);
+  EXPECT_GT(inside, 25);
 }

@@ -15,7 +15,7 @@
 // until no overlap exceeds 0.9 margin, so every surface, and with it every vertex, keeps
 // clearance + margin / 10; a step that does not get there within its sweeps, or gains less than
 // 1 % on its largest overlap in 60 sweeps, is undone and halved (a step that succeeds is followed
-// by one 1.5 times as long), and growth stops, not reached, when the step falls below 1e-3 or the
+// by one 1.5 times as long), and growth stops, not reached, when the step falls below 0.0025 or the
 // sweeps run out. Periodic images, a cell's own included, count as other cells.
 //
 // Cost: pairs of cells whose boxes (in their own frames, widened by d / 2) do not overlap are
