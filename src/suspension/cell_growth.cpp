@@ -384,16 +384,16 @@ class Grower {
     for (std::size_t patch = 0; patch < patch_centre_.size(); ++patch) {
       if (!distance_.near(ab * patch_centre_[patch] + shift_ab, patch_radius_[patch])) continue;
       for (int k = patch_start_[patch]; k < patch_start_[patch + 1]; ++k) {
-      const Eigen::Index i = patch_vertex_[k];
-      const Vec3 p = row(world_, static_cast<Eigen::Index>(a) * nv + i);
-      const Vec3 q = ab * row(reference_, i) + shift_ab;
-      if (!distance_.query(q, hit)) continue;
-      const double o = working_ - s * hit.distance;
-      if (o <= 0) continue;
-      max_overlap_ = std::max(max_overlap_, o);
-      const Vec3 f = o * (Rb * hit.outward);
-      push_[a].add(p - cells[a].centre, f);
-      push_[b].add(Rb * (s * hit.closest), -f);
+        const Eigen::Index i = patch_vertex_[k];
+        const Vec3 p = row(world_, static_cast<Eigen::Index>(a) * nv + i);
+        const Vec3 q = ab * row(reference_, i) + shift_ab;
+        if (!distance_.query(q, hit)) continue;
+        const double o = working_ - s * hit.distance;
+        if (o <= 0) continue;
+        max_overlap_ = std::max(max_overlap_, o);
+        const Vec3 f = o * (Rb * hit.outward);
+        push_[a].add(p - cells[a].centre, f);
+        push_[b].add(Rb * (s * hit.closest), -f);
       }
     }
   }
