@@ -13,7 +13,8 @@
 //   BM_PipeflowFluid     the fluid step alone (the same lattice, no cells): cells_fraction of the
 //                        whole step = 1 - fluid / step, computed by scripts from the two.
 //   BM_PipeflowHt03Step  the same tube at tube hematocrit 0.3 (red blood cells only, placed by
-//                        place_cells from seed 1 with the same clearance: about 80 cells).
+//                        place_cells from seed 1 with the same clearance: 79 cells, grown from 0.6
+//                        of their size where random addition jams at 47).
 //   BM_ExtraCellMemory   the heap a suspension grows by per red blood cell added to the
 //                        pipeflow case (20 more, stepped twice so that every per-vertex array has
 //                        grown): bytes_per_cell and bytes_per_vertex, against positions and forces

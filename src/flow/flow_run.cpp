@@ -124,8 +124,11 @@ FlowRun::FlowRun(const FlowRunSpec& spec, const std::function<void(const std::st
     } else {
       placement_ = place_cells(vessel_um_, *kind_.reference_um.topology_ptr(), kind_.reference_um.positions(), p);
     }
-    say(fmt::format("placed {} cells at tube hematocrit {:.4g} (seed {}, {} attempts)", placement_.cells.size(),
-                    placement_.hematocrit, spec_.seed, placement_.attempts));
+    say(fmt::format("placed {} cells at tube hematocrit {:.4g} (seed {}, {} attempts{})", placement_.cells.size(),
+                    placement_.hematocrit, spec_.seed, placement_.attempts,
+                    placement_.initial_scale < 1 ? fmt::format("; grown from {:g} of their size in {} sweeps", placement_.initial_scale,
+                                                               placement_.sweeps)
+                                                 : std::string()));
   }
 
   SuspensionSolverOptions o;
