@@ -56,4 +56,11 @@ std::optional<std::string> mesh_leak_warning(const CellKind& kind, double dx_um,
 /// kind's topology and one bending method.
 std::shared_ptr<const MembraneModel> lattice_membrane(const CellKind& kind, const lbm::FlowUnits& units);
 
+/// The same membrane in um and pN, for a cell outside a flow (bendlab stretch): positions in um,
+/// k_S = 3 G_s in pN/um (1 uN/m = 1 pN/um), kappa_B in pN um (1e-18 J), nodal forces in pN. The
+/// volume force is the one a flow run with lattice spacing `volume_dx_um` applies: ESPResSo's
+/// force, -kappa_V (V - V0)/V A_t n_t per triangle and vertex, is written for positions in dx, so
+/// kappa_V = ratio k_S in lattice units is kappa_V = ratio k_S / dx in um (docs/conventions.md §7).
+std::shared_ptr<const MembraneModel> physical_membrane(const CellKind& kind, double volume_dx_um);
+
 }  // namespace bendlab
