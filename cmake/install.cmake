@@ -23,6 +23,7 @@ install(DIRECTORY ${PROJECT_SOURCE_DIR}/include/bendlab DESTINATION ${CMAKE_INST
 install(TARGETS bendlab_cli RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 # The CLI finds its plotting scripts in <prefix>/share/bendlab/scripts (core/helper_program.hpp).
 install(FILES ${PROJECT_SOURCE_DIR}/scripts/plot_rbc.py ${PROJECT_SOURCE_DIR}/scripts/plot_shear.py
+              ${PROJECT_SOURCE_DIR}/scripts/plot_stretch.py ${PROJECT_SOURCE_DIR}/scripts/mills2004_stretch.csv
         DESTINATION ${CMAKE_INSTALL_DATADIR}/bendlab/scripts)
 install(EXPORT bendlabTargets NAMESPACE bendlab:: DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/bendlab)
 configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/bendlabConfig.cmake.in

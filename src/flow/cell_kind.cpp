@@ -88,4 +88,17 @@ std::shared_ptr<const MembraneModel> lattice_membrane(const CellKind& kind, cons
   return std::make_shared<const MembraneModel>(lattice_mesh, std::move(p));
 }
 
+std::shared_ptr<const MembraneModel> physical_membrane(const CellKind& kind) {
+  const CellKindSpec& s = kind.spec;
+  MembraneParameters p;
+  p.elastic_law = s.elastic_law;
+  p.skalak_c = s.skalak_c;
+  p.kS = 3.0 * s.shear_modulus * 1e6;  // k_S = 3 G_s; N/m -> pN/um
+  p.kB = s.bending_modulus * 1e18;     // J -> pN um
+  if (p.kB > 0) p.bending = make_bending_method(s.method, parse_options(s.method_options));
+  if (s.volume_modulus_ratio > 0)
+    p.volume_force = std::make_shared<const EspressoVolumeForce>(s.volume_modulus_ratio * p.kS / s.radius_um);
+  return std::make_shared<const MembraneModel>(kind.reference_um, std::move(p));
+}
+
 }  // namespace bendlab

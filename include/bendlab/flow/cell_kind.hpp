@@ -59,4 +59,9 @@ std::optional<std::string> mesh_leak_warning(const CellKind& kind, double dx_um,
 /// kind's topology and one bending method.
 std::shared_ptr<const MembraneModel> lattice_membrane(const CellKind& kind, const lbm::FlowUnits& units);
 
+/// The same membrane in um and pN, for a cell outside a flow (bendlab stretch): positions in um,
+/// k_S = 3 G_s in pN/um (1 uN/m = 1 pN/um), kappa_B in pN um (1e-18 J), nodal forces in pN, and
+/// the volume force of a flow run, kappa_V = ratio k_S / R (the cell's radius; docs/conventions.md §6).
+std::shared_ptr<const MembraneModel> physical_membrane(const CellKind& kind);
+
 }  // namespace bendlab
