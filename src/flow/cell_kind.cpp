@@ -27,6 +27,19 @@ MethodOptions parse_options(const std::vector<std::string>& options) {
 }
 }  // namespace
 
+nlohmann::json CellKindSpec::to_json() const {
+  return {{"cell", shape},
+          {"cell_radius_um", radius_um},
+          {"mesh", mesh},
+          {"elastic_law", elastic_law},
+          {"shear_modulus", shear_modulus},
+          {"skalak_c", skalak_c},
+          {"bending_modulus", bending_modulus},
+          {"method", method},
+          {"method_options", method_options},
+          {"volume_modulus_ratio", volume_modulus_ratio}};
+}
+
 void check_cell_kind(const CellKindSpec& s) {
   require(s.shape == "rbc" || s.shape == "sphere", fmt::format("--cell '{}' is not a cell kind (rbc, sphere)", s.shape));
   require(s.radius_um > 0 && std::isfinite(s.radius_um), fmt::format("--cell-radius {} um must be finite and positive", s.radius_um));

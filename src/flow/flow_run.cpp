@@ -17,22 +17,13 @@ nlohmann::json FlowRunSpec::to_json() const {
                       {"tau", u.tau},
                       {"plasma_viscosity", u.plasma.viscosity},
                       {"plasma_density", u.plasma.density},
-                      {"cell", cell.shape},
-                      {"cell_radius_um", cell.radius_um},
-                      {"mesh", cell.mesh},
-                      {"elastic_law", cell.elastic_law},
-                      {"shear_modulus", cell.shear_modulus},
-                      {"skalak_c", cell.skalak_c},
-                      {"bending_modulus", cell.bending_modulus},
-                      {"method", cell.method},
-                      {"method_options", cell.method_options},
-                      {"volume_modulus_ratio", cell.volume_modulus_ratio},
                       {"seed", seed},
                       {"contact_cutoff_um", contact_cutoff_um},
                       {"contact_force", contact_force},
                       {"sample_every", sample_every},
                       {"steady_from", steady_from},
                       {"slice_width_um", slice_width_um}};
+  j.update(cell.to_json());
   if (tube) {
     j["diameter_um"] = u.diameter_um;
   } else {

@@ -24,22 +24,13 @@ double max_row_norm(const Points& a) { return a.rows() > 0 ? a.rowwise().norm().
 
 nlohmann::json StretchSpec::to_json() const {
   const FireParameters& f = fire;
-  return {{"cell", cell.shape},
-          {"cell_radius_um", cell.radius_um},
-          {"mesh", cell.mesh},
-          {"elastic_law", cell.elastic_law},
-          {"shear_modulus", cell.shear_modulus},
-          {"skalak_c", cell.skalak_c},
-          {"bending_modulus", cell.bending_modulus},
-          {"method", cell.method},
-          {"method_options", cell.method_options},
-          {"volume_modulus_ratio", cell.volume_modulus_ratio},
-          {"forces_pN", forces_pN},
-          {"fraction", fraction},
-          {"tolerance_pN", tolerance_pN},
-          {"max_iterations", max_iterations},
-          {"fire",
-           {{"n_min", f.n_min},
+  nlohmann::json j = cell.to_json();
+  const nlohmann::json own = {{"forces_pN", forces_pN},
+                              {"fraction", fraction},
+                              {"tolerance_pN", tolerance_pN},
+                              {"max_iterations", max_iterations},
+                              {"fire",
+                               {{"n_min", f.n_min},
             {"f_inc", f.f_inc},
             {"f_dec", f.f_dec},
             {"alpha_start", f.alpha_start},
@@ -47,6 +38,8 @@ nlohmann::json StretchSpec::to_json() const {
             {"dt_max_factor", f.dt_max_factor},
             {"dt_start_fraction", f.dt_start_fraction},
             {"max_step_edges", f.max_step_edges}}}};
+  j.update(own);
+  return j;
 }
 
 nlohmann::json StretchPoint::to_json() const {

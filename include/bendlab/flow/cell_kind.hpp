@@ -11,6 +11,7 @@
 // Every cell of a kind shares its topology, reference shape and bending method: per cell a run
 // keeps positions and forces only.
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -33,6 +34,11 @@ struct CellKindSpec {
   std::string method = "C";           ///< bending method ("none": no bending force)
   std::vector<std::string> method_options;  ///< name=value
   double volume_modulus_ratio = 100;  ///< kappa_V R / kappa_S of ESPResSo's volume force (R the radius)
+
+  /// The fields that make a cell kind (a run's arguments): cell, cell_radius_um, mesh,
+  /// elastic_law, shear_modulus, skalak_c, bending_modulus, method, method_options,
+  /// volume_modulus_ratio.
+  nlohmann::json to_json() const;
 };
 
 /// Throws bendlab::Error, naming the option, for an unknown shape or law, a non-positive or
