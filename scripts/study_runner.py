@@ -368,7 +368,8 @@ class Runner:
             last = ""
             try:
                 for line in (d / "run.log").read_text().splitlines():
-                    if line.startswith("gamma t ="):
+                    # shear's progress lines start "gamma t =", flow's and the others' "t ="
+                    if line.startswith(("gamma t =", "t =")):
                         last = line
             except OSError:
                 pass

@@ -1,0 +1,309 @@
+#!/usr/bin/python3
+"""One red blood cell in a tube: the parachute and the slipper (`bendlab flow --cells 1`).
+
+    /usr/bin/python3 scripts/tube_shapes.py [--rates LIST] [--travel D] [--jobs N] [--bendlab PATH]
+                                            [--work DIR] [--doc FILE] [--list] [--doc-only]
+
+A single cell of the flow command's red blood cell (docs/conventions.md §6: eq. (15) at
+R = 3.91 um, Skalak G_s = 5.3 uN/m, C = 10, kappa_B = 2e-19 J, Method C, 1280 triangles) in a
+rigid tube of D = 10 um, periodic over 3 D, dx = 0.5 um, tau = 1.82 (the tube study's lattice),
+started where the flow command's placement puts it (seed 1: off the axis, at a random
+orientation), driven at each pseudo-shear rate v / D of --rates for long enough that the cell
+travels about --travel (20) tube diameters. Nothing is tuned.
+
+The shape measures (over the last quarter of each run's snapshots; mean and the spread):
+  offset        distance of the cell's centroid from the tube axis over the tube radius
+                (0 on the axis; a parachute is centred, a slipper sits off it)
+  roundness     sqrt(lambda_min / lambda_max) of the covariance of the vertices' (y, z) about
+                their mean: the cross-section seen along the flow (1 for an axisymmetric shape)
+  tilt          angle between the flow axis and the short principal axis of the cell's vertex
+                covariance (0 when the cell's axis of symmetry lies along the flow, as a
+                parachute's does)
+and, for the phase diagram of Fedosov, Peltomaki & Gompper, Soft Matter 10:4258 (2014), the
+confinement chi = D_r / D (D_r = sqrt(A / pi), A the cell's area) and the dimensionless rate
+gamma* = (v / D) eta D_r^3 / kappa_B.
+
+Runs lie under --work (default studies/tube_shapes, kept in git without their fluid states);
+a finished run is not run again (scripts/study_runner.py). Writes docs/results/tube_shapes.md
+and its pictures (docs/results/tube_shapes/).
+"""
+import argparse
+import math
+import re
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import study_runner  # noqa: E402
+from study_runner import ROOT, fmt_g  # noqa: E402
+
+DIAMETER = 10.0
+LENGTH = 3 * DIAMETER
+DX = 0.5
+TAU = 1.82
+SEED = 1
+RATES = [400.0, 50.0]
+TRAVEL_DIAMETERS = 20.0  # t_end = travel / rate: the cell-free mean velocity covers this many D
+SNAPSHOTS = 40
+PLASMA_VISCOSITY = 1.2e-3   # Pa s, the flow command's default
+BENDING_MODULUS = 2e-19     # J, the flow command's default
+
+
+def t_end_of(rate, travel=TRAVEL_DIAMETERS):
+    return float(f"{travel / rate:.6g}")
+
+
+@dataclass(frozen=True)
+class ShapeRun(study_runner.StudyRun):
+    rate: float
+    t_end: float
+    start_arguments = ("--overwrite",)
+
+    @property
+    def name(self):
+        return f"D{fmt_g(DIAMETER)}_rate{fmt_g(self.rate)}"
+
+    def arguments(self, out):
+        return ["flow", "--geometry", "tube", "--diameter", fmt_g(DIAMETER), "--length", fmt_g(LENGTH),
+                "--dx", fmt_g(DX), "--tau", fmt_g(TAU), "--pseudo-shear-rate", fmt_g(self.rate),
+                "--cells", "1", "--seed", str(SEED), "--t-end", fmt_g(self.t_end),
+                "--sample-every", fmt_g(self.t_end / 400), "--snapshot-every", fmt_g(self.t_end / SNAPSHOTS),
+                "--out", str(out)]
+
+    def key(self):
+        return {"t_end": self.t_end, "diameter_um": DIAMETER, "method": "C", "tau": TAU, "dx_um": DX,
+                "pseudo_shear_rate": self.rate, "seed": SEED}
+
+    def label(self):
+        return f"one cell, D = {fmt_g(DIAMETER)} um, v/D = {fmt_g(self.rate)} 1/s"
+
+
+# ----------------------------------------------------------------------------- snapshots
+
+def read_vtp(path):
+    """(points (n, 3), triangles (m, 3)) of an ASCII .vtp written by the flow command."""
+    text = Path(path).read_text()
+
+    def array(name):
+        m = re.search(r'Name="%s"[^>]*>(.*?)</DataArray>' % name, text, re.S)
+        if m is None:
+            raise ValueError(f"{path}: no DataArray {name}")
+        return np.array(m.group(1).split(), dtype=float)
+
+    points = array("Points").reshape(-1, 3)
+    conn = array("connectivity").astype(int)
+    offsets = array("offsets").astype(int)
+    if not np.all(np.diff(np.concatenate([[0], offsets])) == 3):
+        raise ValueError(f"{path}: not a triangle mesh")
+    return points, conn.reshape(-1, 3)
+
+
+def snapshots(folder):
+    return sorted(Path(folder).glob("snapshot_*.vtp"))
+
+
+def measures(points, radius):
+    """offset, roundness and tilt (deg) of one cell's vertices (see the module's description)."""
+    c = points.mean(axis=0)
+    offset = math.hypot(c[1], c[2]) / radius
+    q = points - c
+    yz = np.linalg.eigvalsh(np.cov(q[:, 1:].T))
+    roundness = math.sqrt(max(yz[0], 0.0) / yz[1])
+    w, v = np.linalg.eigh(np.cov(q.T))
+    short = v[:, 0]
+    tilt = math.degrees(math.acos(min(1.0, abs(short[0]))))
+    return offset, roundness, tilt
+
+
+def run_measures(folder):
+    """The measures of every snapshot: arrays offset, roundness, tilt."""
+    rows = [measures(read_vtp(p)[0], DIAMETER / 2) for p in snapshots(folder)]
+    return np.array(rows).reshape(-1, 3)
+
+
+def area(points, tris):
+    a, b, c = points[tris[:, 0]], points[tris[:, 1]], points[tris[:, 2]]
+    return 0.5 * float(np.linalg.norm(np.cross(b - a, c - a), axis=1).sum())
+
+
+def classify(offset, roundness, tilt, offset_range):
+    """The shape's name from its measures over the last quarter of the run: centred, round across
+    the flow and aligned with it is a parachute; off the axis and tilted is a slipper; a shape whose
+    offset still moves by more than 0.05 of the radius is not steady yet."""
+    if offset_range > 0.05:
+        return "not steady"
+    if offset < 0.1 and roundness > 0.85 and tilt < 10:
+        return "parachute"
+    if offset >= 0.1 and tilt >= 10:
+        return "slipper"
+    return "neither"
+
+
+# ----------------------------------------------------------------------------- pictures
+
+def draw(ax, points, tris, view):
+    """The cell seen along -y (side) or along +x (front), shaded by the light from the viewer."""
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+    c = points.mean(axis=0)
+    p = points.copy()
+    p[:, 0] -= c[0]  # the cell's x about its centroid; y, z about the tube axis
+    tri = p[tris]
+    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    n /= np.linalg.norm(n, axis=1, keepdims=True)
+    light = np.array([0.3, -1.0, 0.4]) if view == "side" else np.array([-1.0, 0.3, 0.4])
+    light /= np.linalg.norm(light)
+    shade = 0.35 + 0.65 * np.abs(n @ light)
+    col = Poly3DCollection(tri, facecolors=np.outer(shade, [0.85, 0.2, 0.2]), edgecolors="none")
+    ax.add_collection3d(col)
+    r = DIAMETER / 2
+    t = np.linspace(0, 2 * np.pi, 100)
+    if view == "side":
+        for z in (-r, r):
+            ax.plot([-6, 6], [r, r], [z, z], color="0.4", lw=1)
+        ax.view_init(elev=0, azim=-90)
+    else:
+        ax.plot(np.full_like(t, -6), r * np.cos(t), r * np.sin(t), color="0.4", lw=1)
+        ax.view_init(elev=0, azim=180)
+    ax.set_xlim(-6, 6)
+    ax.set_ylim(-r, r)
+    ax.set_zlim(-r, r)
+    ax.set_box_aspect((12, 2 * r, 2 * r))
+    ax.set_axis_off()
+
+
+def picture(path, folder, title):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    points, tris = read_vtp(snapshots(folder)[-1])
+    fig = plt.figure(figsize=(8, 3.6))
+    for k, view in enumerate(("side", "front")):
+        ax = fig.add_subplot(1, 2, k + 1, projection="3d")
+        draw(ax, points, tris, view)
+        ax.set_title("side (flow to the right)" if view == "side" else "along the flow", fontsize=9)
+    fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def history(path, rows):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, axes = plt.subplots(1, 3, figsize=(10, 3))
+    for rate, t, m in rows:
+        for k, (ax, name) in enumerate(zip(axes, ("offset / (D/2)", "roundness", "tilt (deg)"))):
+            ax.plot(t * rate, m[:, k], ".-", lw=1, label=f"v/D = {fmt_g(rate)} 1/s")
+            ax.set_xlabel("t v / D (tube diameters travelled)")
+            ax.set_ylabel(name)
+    axes[0].legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+# ----------------------------------------------------------------------------- main
+
+def main(argv):
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--rates", default=",".join(fmt_g(r) for r in RATES),
+                    help="pseudo-shear rates v/D, 1/s, comma-separated")
+    ap.add_argument("--travel", type=float, default=TRAVEL_DIAMETERS,
+                    help="tube diameters the cell-free mean velocity covers in a run (sets t_end)")
+    ap.add_argument("--jobs", type=int, default=1)
+    ap.add_argument("--bendlab", default="build/release/bendlab")
+    ap.add_argument("--work", default=str(ROOT / "studies" / "tube_shapes"))
+    ap.add_argument("--doc", default=str(ROOT / "docs" / "results" / "tube_shapes.md"))
+    ap.add_argument("--binary-commit", default=None, help="the commit whose bendlab made the runs (for the document)")
+    ap.add_argument("--list", action="store_true", help="print the runs and their state; run nothing")
+    ap.add_argument("--doc-only", action="store_true", help="write the document from the finished runs; run nothing")
+    args = ap.parse_args(argv[1:])
+    try:
+        rates = [float(r) for r in args.rates.split(",")]
+    except ValueError:
+        raise SystemExit(f"error: --rates: not a list of numbers: '{args.rates}'")
+    if not rates or any(not (r > 0 and math.isfinite(r)) for r in rates):
+        raise SystemExit(f"error: --rates: every rate must be positive: '{args.rates}'")
+
+    if not (args.travel > 0 and math.isfinite(args.travel)):
+        raise SystemExit(f"error: --travel must be positive: {args.travel}")
+    runs = [ShapeRun(r, t_end_of(r, args.travel)) for r in rates]
+    work = Path(args.work)
+    bendlab = study_runner.bendlab_binary(args.bendlab) if not args.doc_only else None
+    runner = study_runner.Runner(bendlab, work, jobs=args.jobs)
+    if args.list:
+        return runner.list(runs, "tube shapes")
+    if not args.doc_only:
+        runner.run_all(runs)
+
+    doc = Path(args.doc)
+    fig_dir = doc.parent / doc.stem
+    fig_dir.mkdir(parents=True, exist_ok=True)
+    L = ["# One red blood cell in a tube: parachute and slipper", ""]
+    L += study_runner.generated_by(study_runner.invocation(Path(__file__), argv[1:]))
+    L += [f"from {study_runner.source_commit() or 'an unknown commit'} on {study_runner.machine()}, "
+          f"{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}"
+          + (f"; the runs were made by the bendlab of commit {args.binary_commit}" if args.binary_commit else "")
+          + ".", ""]
+    L += [f"One cell of the flow command's red blood cell (docs/conventions.md §6) in a tube of D = {fmt_g(DIAMETER)} um, "
+          f"periodic over {fmt_g(LENGTH)} um, dx = {fmt_g(DX)} um, tau = {fmt_g(TAU)}, placed by seed {SEED} "
+          "(off the axis, at a random orientation); each run lasts until the cell-free mean velocity has "
+          f"covered {fmt_g(args.travel)} tube diameters. The measures are those of scripts/tube_shapes.py's "
+          "description, over the last quarter of the run's snapshots (mean, and the range in brackets).", ""]
+    L += ["| v / D (1/s) | gamma* | t_end (s) | offset / (D/2) | roundness | tilt (deg) | shape |",
+          "| --- | --- | --- | --- | --- | --- | --- |"]
+    hist = []
+    chi = None
+    pictures = []
+    for r in runs:
+        folder = work / r.name
+        s = study_runner.read_summary(folder)
+        if s is None or not study_runner.matches(s, r.key()):
+            L.append(f"| {fmt_g(r.rate)} | | {fmt_g(r.t_end)} | not run yet | | | |")
+            continue
+        snaps = snapshots(folder)
+        points, tris = read_vtp(snaps[-1])
+        D_r = math.sqrt(area(points, tris) / math.pi)
+        chi = D_r / DIAMETER
+        gamma_star = r.rate * PLASMA_VISCOSITY * (D_r * 1e-6) ** 3 / BENDING_MODULUS
+        m = run_measures(folder)
+        t = np.linspace(0, r.t_end, len(snaps))
+        hist.append((r.rate, t, m))
+        last = m[len(m) - max(1, len(m) // 4):]
+        mean = last.mean(axis=0)
+        cells = [f"{mean[k]:.3g} [{last[:, k].min():.3g}, {last[:, k].max():.3g}]" for k in range(3)]
+        shape = classify(*mean, offset_range=float(np.ptp(last[:, 0])))
+        L.append(f"| {fmt_g(r.rate)} | {gamma_star:.3g} | {fmt_g(r.t_end)} | {' | '.join(cells)} | {shape} |")
+        png = fig_dir / f"{r.name}.png"
+        picture(png, folder, f"v/D = {fmt_g(r.rate)} 1/s: {shape}")
+        pictures.append((r, png, shape, gamma_star))
+    L.append("")
+    if hist:
+        history(fig_dir / "history.png", hist)
+        L += [f"![the measures against the distance travelled]({fig_dir.name}/history.png)", ""]
+    for r, png, shape, gamma_star in pictures:
+        L += [f"![v/D = {fmt_g(r.rate)} 1/s]({fig_dir.name}/{png.name})", ""]
+    if chi is not None:
+        L += ["## In the phase diagram of Fedosov, Peltomaki & Gompper (2014)", "",
+              f"Their confinement is chi = D_r / D with D_r = sqrt(A / pi): here D_r = {chi * DIAMETER:.3g} um "
+              f"and chi = {chi:.3g}; their dimensionless rate is gamma* = (v / D) eta D_r^3 / kappa_B "
+              f"(eta = {PLASMA_VISCOSITY:g} Pa s, kappa_B = {BENDING_MODULUS:g} J). Their diagram "
+              "(shared/spec/CELLS_IN_CHANNELS.md section 5 summarises it) has centred, axisymmetric parachutes "
+              "at strong confinement and high rates, and off-centre slippers at weaker confinement and lower "
+              "rates. The runs above sit at:", ""]
+        for r, png, shape, gamma_star in pictures:
+            L.append(f"- v/D = {fmt_g(r.rate)} 1/s: (chi, gamma*) = ({chi:.3g}, {gamma_star:.3g}), "
+                     f"a {shape} here.")
+        L.append("")
+    doc.write_text("\n".join(L))
+    print(f"wrote {study_runner.rel(doc)} and {study_runner.rel(fig_dir)}/")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))
