@@ -3,7 +3,7 @@
 Pries et al., and what the bending algorithm changes (`bendlab flow` runs; issue "Blood in a glass
 tube").
 
-    /usr/bin/python3 scripts/tube_study.py [--only diameters|hematocrit|methods|resolution|doc]
+    /usr/bin/python3 scripts/tube_study.py [--only diameters|hematocrit|methods|resolution|sensitivity|doc]
                                            [--t-end S] [--jobs N] [--methods LIST] [--bendlab PATH]
                                            [--work DIR]
                                            [--doc FILE] [--list]
@@ -14,6 +14,8 @@ Parts (each run one `bendlab flow` process):
   diameters   D = 10, 15, 20 um at H_T = 0.3, Method C.
   hematocrit  D = 10 um at H_T = 0.2 and 0.4, Method C.
   resolution  the D = 10 um, H_T = 0.3, Method C case with 5120-triangle cells.
+  sensitivity the same case with the repulsion's cutoff halved (0.25 um) and with a periodic
+              length of three diameters.
   doc         only regenerates the document from the runs that are done.
 Without --only: methods, then diameters, hematocrit and resolution.
 
@@ -95,28 +97,37 @@ class Run(study_runner.StudyRun):
     method: str
     mesh: str
     t_end: float
+    contact_cutoff: float = 0.0   # um; 0: the flow command's default, one dx
+    length_factor: float = 2.0    # the periodic length in tube diameters
     start_arguments = ("--overwrite",)
 
     def arguments(self, out):
+        extra = ["--contact-cutoff", fmt_g(self.contact_cutoff)] if self.contact_cutoff else []
         return ["flow", "--geometry", "tube", "--diameter", fmt_g(self.diameter), "--length",
-                fmt_g(2 * self.diameter), "--dx", fmt_g(DX), "--tau", fmt_g(TAU), "--pseudo-shear-rate",
-                fmt_g(PSEUDO_SHEAR_RATE), "--hematocrit", fmt_g(self.hematocrit), "--seed", str(SEED),
-                "--method", self.method, "--mesh", self.mesh, "--t-end", fmt_g(self.t_end), "--sample-every",
-                fmt_g(SAMPLE_EVERY), "--snapshot-every", fmt_g(SNAPSHOT_EVERY), "--out", str(out)]
+                fmt_g(self.length_factor * self.diameter), "--dx", fmt_g(DX), "--tau", fmt_g(TAU),
+                "--pseudo-shear-rate", fmt_g(PSEUDO_SHEAR_RATE), "--hematocrit", fmt_g(self.hematocrit),
+                "--seed", str(SEED), "--method", self.method, "--mesh", self.mesh, "--t-end", fmt_g(self.t_end),
+                "--sample-every", fmt_g(SAMPLE_EVERY), "--snapshot-every", fmt_g(SNAPSHOT_EVERY)] + extra + [
+                "--out", str(out)]
 
     def key(self):
         return {"t_end": self.t_end, "diameter_um": self.diameter, "hematocrit": self.hematocrit,
                 "method": self.method, "mesh": self.mesh, "tau": TAU, "dx_um": DX,
-                "pseudo_shear_rate": PSEUDO_SHEAR_RATE, "seed": SEED}
+                "pseudo_shear_rate": PSEUDO_SHEAR_RATE, "seed": SEED, "contact_cutoff_um": self.contact_cutoff,
+                "length_um": self.length_factor * self.diameter}
 
     def label(self):
+        extra = (f", cutoff {fmt_g(self.contact_cutoff)} um" if self.contact_cutoff else "") + (
+            f", L = {fmt_g(self.length_factor)} D" if self.length_factor != 2.0 else "")
         return (f"D = {fmt_g(self.diameter)} um, H_T {fmt_g(self.hematocrit)}, Method {self.method}, "
-                f"{self.mesh}")
+                f"{self.mesh}{extra}")
 
 
-def run(D, H, method="C", mesh="mt1:1280", t_end=T_END):
+def run(D, H, method="C", mesh="mt1:1280", t_end=T_END, contact_cutoff=0.0, length_factor=2.0):
     name = f"D{fmt_g(D)}_H{fmt_g(H)}_{method}_{mesh.replace(':', '')}"
-    return Run(name, D, H, method, mesh, t_end)
+    name += (f"_cut{fmt_g(contact_cutoff)}" if contact_cutoff else "") + (
+        f"_L{fmt_g(length_factor)}D" if length_factor != 2.0 else "")
+    return Run(name, D, H, method, mesh, t_end, contact_cutoff, length_factor)
 
 
 def parts(t_end, methods=METHODS):
@@ -125,6 +136,8 @@ def parts(t_end, methods=METHODS):
         "diameters": [run(D, 0.3, t_end=t_end) for D in (10, 15, 20)],
         "hematocrit": [run(10, H, t_end=t_end) for H in (0.2, 0.4)],
         "resolution": [run(10, 0.3, "C", "mt1:5120", t_end=t_end)],
+        # What the departure from Pries' law could come from: the repulsion's reach and the period.
+        "sensitivity": [run(10, 0.3, t_end=t_end, contact_cutoff=0.25), run(10, 0.3, t_end=t_end, length_factor=3.0)],
     }
 
 
@@ -216,11 +229,14 @@ def write_doc(argv, work, doc, all_parts, binary_commit=None):
               f"![eta_app / eta against time; the dotted line starts the steady window]({rel}/transient.png)", ""]
 
     def table(part, first_column, cell):
+        return table_of(all_parts, part, first_column, cell)
+
+    def table_of(parts_, part, first_column, cell):
         rows = ["| " + first_column + " | H_T placed | H_D | eta_app / eta | Pries 1992 at H_D | "
                 "H_T / H_D (H_T mean over H_D mean) | Fahraeus at H_D | cell-free layer (um) | cell D | "
                 "cell axis angle (deg) | wall time |",
                 "|" + " --- |" * 11]
-        for r in all_parts[part]:
+        for r in parts_[part]:
             s = done(r, work)
             if s is None:
                 err = failure(r, work)
@@ -286,6 +302,16 @@ def write_doc(argv, work, doc, all_parts, binary_commit=None):
     L += table("hematocrit", "H_T target", lambda r: fmt_g(r.hematocrit))
     L += ["## Resolution", "", "The D = 10 um, H_T = 0.3, Method C case with cells of 1280 and 5120 triangles:", ""]
     L += table("resolution", "mesh", lambda r: r.mesh)
+    L += ["## Sensitivity", "",
+          "The D = 10 um, H_T = 0.3, Method C case (first row) with the repulsion's cutoff halved to 0.25 um "
+          "(from one dx), and with the periodic length three diameters instead of two:", ""]
+    base = all_parts["methods"][0] if all_parts["methods"] and all_parts["methods"][0].method == "C" else None
+    sens = dict(all_parts)
+    sens["sensitivity"] = ([base] if base else []) + all_parts["sensitivity"]
+    L += table_of(sens, "sensitivity", "variant",
+                  lambda r: ", ".join(filter(None, [f"cutoff {fmt_g(r.contact_cutoff)} um" if r.contact_cutoff else "",
+                                                    f"L = {fmt_g(r.length_factor)} D" if r.length_factor != 2.0 else ""]))
+                  or "as in the methods table")
 
     # eta_rel and H_T / H_D against D, beside the laws.
     d_runs = [(r, done(r, work)) for r in all_parts["diameters"]]
@@ -384,7 +410,8 @@ def render_cells(vtp, summary, png):
 
 def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--only", choices=["methods", "diameters", "hematocrit", "resolution", "doc"], default=None)
+    p.add_argument("--only", choices=["methods", "diameters", "hematocrit", "resolution", "sensitivity", "doc"],
+                   default=None)
     p.add_argument("--t-end", type=float, default=T_END, help="end of every run, s")
     p.add_argument("--jobs", type=int, default=1)
     p.add_argument("--methods", default=",".join(METHODS),
@@ -399,7 +426,7 @@ def main():
     work, doc = Path(a.work), Path(a.doc)
     work.mkdir(parents=True, exist_ok=True)
     all_parts = parts(a.t_end, [m for m in a.methods.split(",") if m])
-    order = ["methods", "diameters", "hematocrit", "resolution"]
+    order = ["methods", "diameters", "hematocrit", "resolution", "sensitivity"]
     todo = [] if a.only == "doc" else (all_parts[a.only] if a.only else [r for k in order for r in all_parts[k]])
     if a.list:
         return study_runner.Runner(a.bendlab, work).list(todo, f"part {a.only or 'all'}")
