@@ -84,13 +84,16 @@ class ShapeRun(study_runner.StudyRun):
 
 # ----------------------------------------------------------------------------- snapshots
 
-def read_vtp(path):
-    """(points (n, 3), triangles (m, 3)) of an ASCII .vtp written by the flow command."""
+def read_vtp(path, with_body=False):
+    """(points (n, 3), triangles (m, 3)) of an ASCII .vtp written by the flow command, and each
+    vertex's cell index (its "body" array, zeros where it has none) when with_body."""
     text = Path(path).read_text()
 
-    def array(name):
+    def array(name, optional=False):
         m = re.search(r'Name="%s"[^>]*>(.*?)</DataArray>' % name, text, re.S)
         if m is None:
+            if optional:
+                return None
             raise ValueError(f"{path}: no DataArray {name}")
         return np.array(m.group(1).split(), dtype=float)
 
@@ -99,6 +102,10 @@ def read_vtp(path):
     offsets = array("offsets").astype(int)
     if not np.all(np.diff(np.concatenate([[0], offsets])) == 3):
         raise ValueError(f"{path}: not a triangle mesh")
+    if with_body:
+        body = array("body", optional=True)
+        body = body.astype(int) if body is not None else np.zeros(len(points), int)
+        return points, conn.reshape(-1, 3), body
     return points, conn.reshape(-1, 3)
 
 

@@ -378,21 +378,15 @@ def write_doc(argv, work, doc, all_parts, binary_commit=None):
 
 def render_cells(vtp, summary, png):
     """Draws the cells of a snapshot (.vtp: every cell's triangles, coloured by cell) in the tube."""
-    import re
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+    from tube_shapes import read_vtp
     try:
-        text = Path(vtp).read_text()
-        pts = np.array(re.search(r"<Points>.*?<DataArray[^>]*>(.*?)</DataArray>", text, re.S).group(1).split(),
-                       float).reshape(-1, 3)
-        conn = np.array(re.search(r'Name="connectivity"[^>]*>(.*?)</DataArray>', text, re.S).group(1).split(), int)
-        body = re.search(r'Name="body"[^>]*>(.*?)</DataArray>', text, re.S)
-    except (OSError, AttributeError, ValueError):
+        pts, tris, cell = read_vtp(vtp, with_body=True)
+    except (OSError, ValueError):
         return False
-    tris = conn.reshape(-1, 3)
-    cell = np.array(body.group(1).split(), float).astype(int) if body else np.zeros(len(pts), int)
     fig = plt.figure(figsize=(8, 3.6))
     ax = fig.add_subplot(111, projection="3d")
     colours = plt.cm.tab10(cell[tris[:, 0]] % 10)
