@@ -11,14 +11,17 @@ started where the flow command's placement puts it (seed 1: off the axis, at a r
 orientation), driven at each pseudo-shear rate v / D of --rates for long enough that the cell
 travels about --travel (20) tube diameters. Nothing is tuned.
 
-The shape measures (over the last quarter of each run's snapshots; mean and the spread):
-  offset        distance of the cell's centroid from the tube axis over the tube radius
+The shape measures (over the last quarter of each run's snapshots; mean and the spread) are read
+from the second moments of the cell's surface, each triangle weighted by its area (exact for the
+flat triangles), so that they describe the shape and not where the mesh's vertices crowd:
+  offset        distance of the surface's centroid from the tube axis over the tube radius
                 (0 on the axis; a parachute is centred, a slipper sits off it)
-  roundness     sqrt(lambda_min / lambda_max) of the covariance of the vertices' (y, z) about
-                their mean: the cross-section seen along the flow (1 for an axisymmetric shape)
-  tilt          angle between the flow axis and the short principal axis of the cell's vertex
-                covariance (0 when the cell's axis of symmetry lies along the flow, as a
-                parachute's does)
+  roundness     sqrt(lambda_min / lambda_max) of the (y, z) block of the second moments: the
+                cross-section seen along the flow (1 for a shape symmetric about the flow axis)
+  tilt          angle between the flow axis and the cell's axis of (near) symmetry: the principal
+                axis whose moment stands furthest, in ratio, from the other two (the short axis of
+                a cup, the long axis of a cigar); 0 when the axis lies along the flow, as a
+                parachute's does
 and, for the phase diagram of Fedosov, Peltomaki & Gompper, Soft Matter 10:4258 (2014), the
 confinement chi = D_r / D (D_r = sqrt(A / pi), A the cell's area) and the dimensionless rate
 gamma* = (v / D) eta D_r^3 / kappa_B.
@@ -113,22 +116,40 @@ def snapshots(folder):
     return sorted(Path(folder).glob("snapshot_*.vtp"))
 
 
-def measures(points, radius):
-    """offset, roundness and tilt (deg) of one cell's vertices (see the module's description)."""
-    c = points.mean(axis=0)
+def surface_moments(points, tris):
+    """(centroid, covariance) of the surface itself: the area-weighted first and second moments
+    of its flat triangles, exactly (the integral of x x^T over a triangle of area A and vertices
+    a, b, c is A (a a^T + b b^T + c c^T + s s^T) / 12 with s = a + b + c)."""
+    a, b, c = points[tris[:, 0]], points[tris[:, 1]], points[tris[:, 2]]
+    w = 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1)
+    s = a + b + c
+    total = w.sum()
+    centroid = (w[:, None] * s).sum(axis=0) / (3 * total)
+    second = sum(np.einsum("i,ij,ik->jk", w, v, v) for v in (a, b, c, s)) / (12 * total)
+    return centroid, second - np.outer(centroid, centroid)
+
+
+def symmetry_axis(covariance):
+    """The principal axis whose moment is furthest, in log ratio, from the other two."""
+    w, v = np.linalg.eigh(covariance)
+    lw = np.log(np.maximum(w, 1e-300))
+    gap = [min(abs(lw[k] - lw[j]) for j in range(3) if j != k) for k in range(3)]
+    return v[:, int(np.argmax(gap))]
+
+
+def measures(points, tris, radius):
+    """offset, roundness and tilt (deg) of one cell's surface (see the module's description)."""
+    c, cov = surface_moments(points, tris)
     offset = math.hypot(c[1], c[2]) / radius
-    q = points - c
-    yz = np.linalg.eigvalsh(np.cov(q[:, 1:].T))
+    yz = np.linalg.eigvalsh(cov[1:, 1:])
     roundness = math.sqrt(max(yz[0], 0.0) / yz[1])
-    w, v = np.linalg.eigh(np.cov(q.T))
-    short = v[:, 0]
-    tilt = math.degrees(math.acos(min(1.0, abs(short[0]))))
+    tilt = math.degrees(math.acos(min(1.0, abs(symmetry_axis(cov)[0]))))
     return offset, roundness, tilt
 
 
 def run_measures(folder):
     """The measures of every snapshot: arrays offset, roundness, tilt."""
-    rows = [measures(read_vtp(p)[0], DIAMETER / 2) for p in snapshots(folder)]
+    rows = [measures(*read_vtp(p), DIAMETER / 2) for p in snapshots(folder)]
     return np.array(rows).reshape(-1, 3)
 
 

@@ -1,6 +1,7 @@
 """The shape measures of scripts/tube_shapes.py on shapes whose answer is known: an axisymmetric
-cup on the axis (offset 0, roundness 1, tilt 0), the same cup moved off the axis and turned, and
-the reading of a .vtp as the flow command writes it."""
+cup on the axis (offset 0, roundness 1, tilt 0), the same cup moved off the axis and turned, a
+long body (its axis of symmetry is its long one), a mesh whose vertices crowd on one side (the
+measures are the surface's), and the reading of a .vtp as the flow command writes it."""
 import math
 import sys
 from pathlib import Path
@@ -11,20 +12,44 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "scripts"))
 import tube_shapes  # noqa: E402
 
 
-def cup(n_theta=24, n_phi=12):
-    """Vertices of an oblate cup symmetric about the x-axis: x short, (y, z) a circle of radius 3."""
-    pts = []
+def revolution(profile, n_theta=24, n_phi=12):
+    """A closed triangulated surface of revolution about the x-axis: profile(phi) -> (x, r) for
+    phi in [0, pi], the poles at phi = 0 and pi on the axis."""
+    pts = [(profile(0.0)[0], 0.0, 0.0)]
     for i in range(1, n_phi):
-        phi = math.pi * i / n_phi
+        x, r = profile(math.pi * i / n_phi)
         for k in range(n_theta):
             t = 2 * math.pi * k / n_theta
-            r = 3 * math.sin(phi)
-            pts.append((1.2 * math.cos(phi) + 0.5 * r * r / 9, r * math.cos(t), r * math.sin(t)))
-    return np.array(pts)
+            pts.append((x, r * math.cos(t), r * math.sin(t)))
+    pts.append((profile(math.pi)[0], 0.0, 0.0))
+    ring = lambda i, k: 1 + (i - 1) * n_theta + k % n_theta  # noqa: E731
+    last = len(pts) - 1
+    tris = [(0, ring(1, k), ring(1, k + 1)) for k in range(n_theta)]
+    for i in range(1, n_phi - 1):
+        for k in range(n_theta):
+            tris += [(ring(i, k), ring(i + 1, k), ring(i + 1, k + 1)), (ring(i, k), ring(i + 1, k + 1), ring(i, k + 1))]
+    tris += [(last, ring(n_phi - 1, k + 1), ring(n_phi - 1, k)) for k in range(n_theta)]
+    return np.array(pts), np.array(tris)
+
+
+def cup():
+    """An oblate cup symmetric about the x-axis: x short, (y, z) a circle of radius 3."""
+    return revolution(lambda phi: (1.2 * math.cos(phi) + 0.5 * math.sin(phi) ** 2, 3 * math.sin(phi)))
+
+
+def cigar():
+    """A prolate body symmetric about the x-axis: x long (half-length 4), radius 1.5."""
+    return revolution(lambda phi: (4 * math.cos(phi), 1.5 * math.sin(phi)))
+
+
+def turned(points, degrees, shift):
+    a = math.radians(degrees)
+    rot = np.array([[math.cos(a), 0, -math.sin(a)], [0, 1, 0], [math.sin(a), 0, math.cos(a)]])  # about y
+    return (points - points.mean(axis=0)) @ rot.T + np.asarray(shift)
 
 
 def test_centred_axisymmetric_cup_is_a_parachute():
-    offset, roundness, tilt = tube_shapes.measures(cup(), radius=5.0)
+    offset, roundness, tilt = tube_shapes.measures(*cup(), radius=5.0)
     assert abs(offset) < 1e-12
     assert abs(roundness - 1) < 1e-12
     assert tilt < 1e-6
@@ -32,16 +57,45 @@ def test_centred_axisymmetric_cup_is_a_parachute():
 
 
 def test_offset_and_tilt_of_a_moved_and_turned_cup():
-    a = math.radians(30)
-    rot = np.array([[math.cos(a), 0, -math.sin(a)], [0, 1, 0], [math.sin(a), 0, math.cos(a)]])  # about y
-    c = cup()
-    p = (c - c.mean(axis=0)) @ rot.T + np.array([7.0, 1.2, -1.6])
-    offset, roundness, tilt = tube_shapes.measures(p, radius=5.0)
-    assert abs(offset - 2.0 / 5.0) < 1e-12  # |(1.2, -1.6)| = 2
+    points, tris = cup()
+    offset, roundness, tilt = tube_shapes.measures(turned(points, 30, [7.0, 1.2, -1.6]), tris, radius=5.0)
+    # the vertex mean and the surface centroid of the cup differ along its axis (x before the turn),
+    # which the turn by 30 deg about y moves into z: the offset is that of the surface centroid
+    c, _ = tube_shapes.surface_moments(turned(points, 30, [7.0, 1.2, -1.6]), tris)
+    assert abs(offset - math.hypot(c[1], c[2]) / 5.0) < 1e-12
+    assert abs(offset - 0.4) < 0.05  # |(1.2, -1.6)| = 2, up to that shift
     assert abs(tilt - 30) < 1e-9
     assert roundness < 0.99
     assert tube_shapes.classify(offset, roundness, tilt, offset_range=0.0) == "slipper"
     assert tube_shapes.classify(offset, roundness, tilt, offset_range=0.2) == "not steady"
+
+
+def test_tilt_follows_the_axis_of_symmetry_of_a_long_body():
+    # the short-axis reading would give 90 deg for a cigar along the flow: the symmetry axis is its long one
+    points, tris = cigar()
+    assert tube_shapes.measures(points, tris, radius=5.0)[2] < 1e-6
+    assert abs(tube_shapes.measures(turned(points, 20, [0, 0, 0]), tris, radius=5.0)[2] - 20) < 1e-9
+
+
+def test_measures_do_not_depend_on_where_the_vertices_crowd():
+    # splitting the triangles on one side at their centroids adds vertices there but not surface:
+    # the surface moments, and so every measure, stay the same (a vertex covariance would move)
+    points, tris = cup()
+    points = turned(points, 25, [0.0, 0.7, 0.3])
+    extra, split = [], []
+    for t in tris:
+        if points[t, 1].mean() > 0.7:
+            m = len(points) + len(extra)
+            extra.append(points[t].mean(axis=0))
+            split += [(t[0], t[1], m), (t[1], t[2], m), (t[2], t[0], m)]
+        else:
+            split.append(tuple(t))
+    crowded = np.vstack([points, extra])
+    assert len(extra) > 50
+    before = tube_shapes.measures(points, tris, radius=5.0)
+    after = tube_shapes.measures(crowded, np.array(split), radius=5.0)
+    assert np.allclose(before, after, rtol=0, atol=1e-9)
+    assert abs(crowded.mean(axis=0)[1] - points.mean(axis=0)[1]) > 0.05  # the vertex mean did move
 
 
 def test_reads_points_and_triangles_of_a_vtp(tmp_path):
