@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""One red blood cell in a tube: the parachute and the slipper (`bendlab flow --cells 1`).
+"""One red blood cell in a tube: its shape at several rates (parachute, croissant, slipper; `bendlab flow --cells 1`).
 
     /usr/bin/python3 scripts/tube_shapes.py [--rates LIST] [--travel D] [--jobs N] [--bendlab PATH]
                                             [--work DIR] [--doc FILE] [--list] [--doc-only]
@@ -18,13 +18,11 @@ flat triangles), so that they describe the shape and not where the mesh's vertic
                 (0 on the axis; a parachute is centred, a slipper sits off it)
   roundness     sqrt(lambda_min / lambda_max) of the (y, z) block of the second moments: the
                 cross-section seen along the flow (1 for a shape symmetric about the flow axis)
-  tilt          angle between the flow axis and the cell's axis of (near) symmetry: the principal
-                axis whose moment stands furthest, in ratio, from the other two (the short axis of
-                a cup, the long axis of a cigar); 0 when the axis lies along the flow, as a
-                parachute's does
 and, for the phase diagram of Fedosov, Peltomaki & Gompper, Soft Matter 10:4258 (2014), the
-confinement chi = D_r / D (D_r = sqrt(A / pi), A the cell's area) and the dimensionless rate
-gamma* = (v / D) eta D_r^3 / kappa_B.
+confinement chi = D_r / D (D_r = sqrt(A / pi), A the cell's area at rest) and the dimensionless
+rate gamma* = (v / D) eta D_r^3 / kappa_B. A tilt of the principal axes is not among the measures:
+the three moments of these cups lie within about a quarter of each other, so their axes swing by
+tens of degrees between snapshots without the shape changing; a slipper is told by its offset.
 
 Runs lie under --work (default studies/tube_shapes, kept in git without their fluid states);
 a finished run is not run again (scripts/study_runner.py). Writes docs/results/tube_shapes.md
@@ -49,7 +47,7 @@ LENGTH = 3 * DIAMETER
 DX = 0.5
 TAU = 1.82
 SEED = 1
-RATES = [400.0, 50.0]
+RATES = [400.0, 200.0, 100.0, 50.0]
 TRAVEL_DIAMETERS = 20.0  # t_end = travel / rate: the cell-free mean velocity covers this many D
 SNAPSHOTS = 40
 PLASMA_VISCOSITY = 1.2e-3   # Pa s, the flow command's default
@@ -129,28 +127,19 @@ def surface_moments(points, tris):
     return centroid, second - np.outer(centroid, centroid)
 
 
-def symmetry_axis(covariance):
-    """The principal axis whose moment is furthest, in log ratio, from the other two."""
-    w, v = np.linalg.eigh(covariance)
-    lw = np.log(np.maximum(w, 1e-300))
-    gap = [min(abs(lw[k] - lw[j]) for j in range(3) if j != k) for k in range(3)]
-    return v[:, int(np.argmax(gap))]
-
-
 def measures(points, tris, radius):
-    """offset, roundness and tilt (deg) of one cell's surface (see the module's description)."""
+    """offset and roundness of one cell's surface (see the module's description)."""
     c, cov = surface_moments(points, tris)
     offset = math.hypot(c[1], c[2]) / radius
     yz = np.linalg.eigvalsh(cov[1:, 1:])
     roundness = math.sqrt(max(yz[0], 0.0) / yz[1])
-    tilt = math.degrees(math.acos(min(1.0, abs(symmetry_axis(cov)[0]))))
-    return offset, roundness, tilt
+    return offset, roundness
 
 
 def run_measures(folder):
-    """The measures of every snapshot: arrays offset, roundness, tilt."""
+    """The measures of every snapshot: rows (offset, roundness)."""
     rows = [measures(*read_vtp(p), DIAMETER / 2) for p in snapshots(folder)]
-    return np.array(rows).reshape(-1, 3)
+    return np.array(rows).reshape(-1, 2)
 
 
 def area(points, tris):
@@ -158,17 +147,17 @@ def area(points, tris):
     return 0.5 * float(np.linalg.norm(np.cross(b - a, c - a), axis=1).sum())
 
 
-def classify(offset, roundness, tilt, offset_range):
-    """The shape's name from its measures over the last quarter of the run: centred, round across
-    the flow and aligned with it is a parachute; off the axis and tilted is a slipper; a shape whose
+def classify(offset, roundness, offset_range):
+    """The shape's name from its measures over the last quarter of the run, in the words of
+    Fedosov, Peltomaki & Gompper (2014) and Guckenberger et al. (2018): centred (offset < 0.1) and
+    round across the flow (roundness > 0.9, axial symmetry) is a parachute; centred but not round
+    (two-fold rather than axial symmetry) is a croissant; off the axis is a slipper; a shape whose
     offset still moves by more than 0.05 of the radius is not steady yet."""
     if offset_range > 0.05:
         return "not steady"
-    if offset < 0.1 and roundness > 0.85 and tilt < 10:
-        return "parachute"
-    if offset >= 0.1 and tilt >= 10:
-        return "slipper"
-    return "neither"
+    if offset < 0.1:
+        return "parachute" if roundness > 0.9 else "croissant"
+    return "slipper"
 
 
 # ----------------------------------------------------------------------------- pictures
@@ -223,9 +212,9 @@ def history(path, rows):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    fig, axes = plt.subplots(1, 3, figsize=(10, 3))
+    fig, axes = plt.subplots(1, 2, figsize=(7, 3))
     for rate, t, m in rows:
-        for k, (ax, name) in enumerate(zip(axes, ("offset / (D/2)", "roundness", "tilt (deg)"))):
+        for k, (ax, name) in enumerate(zip(axes, ("offset / (D/2)", "roundness"))):
             ax.plot(t * rate, m[:, k], ".-", lw=1, label=f"v/D = {fmt_g(rate)} 1/s")
             ax.set_xlabel("t v / D (tube diameters travelled)")
             ax.set_ylabel(name)
@@ -272,7 +261,7 @@ def main(argv):
     doc = Path(args.doc)
     fig_dir = doc.parent / doc.stem
     fig_dir.mkdir(parents=True, exist_ok=True)
-    L = ["# One red blood cell in a tube: parachute and slipper", ""]
+    L = ["# One red blood cell in a tube: parachute, croissant and slipper", ""]
     L += study_runner.generated_by(study_runner.invocation(Path(__file__), argv[1:]))
     L += [f"from {study_runner.source_commit() or 'an unknown commit'} on {study_runner.machine()}, "
           f"{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}"
@@ -282,9 +271,14 @@ def main(argv):
           f"periodic over {fmt_g(LENGTH)} um, dx = {fmt_g(DX)} um, tau = {fmt_g(TAU)}, placed by seed {SEED} "
           "(off the axis, at a random orientation); each run lasts until the cell-free mean velocity has "
           f"covered {fmt_g(args.travel)} tube diameters. The measures are those of scripts/tube_shapes.py's "
-          "description, over the last quarter of the run's snapshots (mean, and the range in brackets).", ""]
-    L += ["| v / D (1/s) | gamma* | t_end (s) | offset / (D/2) | roundness | tilt (deg) | shape |",
-          "| --- | --- | --- | --- | --- | --- | --- |"]
+          "description, over the last quarter of the run's snapshots (mean, and the range in brackets). "
+          "The names are those of Fedosov, Peltomaki & Gompper, Soft Matter 10:4258 (2014) and Guckenberger "
+          "et al., Soft Matter 14:2032 (2018), arXiv:1711.06986, given by scripts/tube_shapes.py's classify(): centred "
+          "(offset < 0.1) and round across the flow (roundness > 0.9) is a parachute; centred but two-fold "
+          "rather than axially symmetric is a croissant; off the axis is a slipper; an offset still moving by "
+          "more than 0.05 over the last quarter is not steady.", ""]
+    L += ["| v / D (1/s) | gamma* | t_end (s) | offset / (D/2) | roundness | shape |",
+          "| --- | --- | --- | --- | --- | --- |"]
     hist = []
     chi = None
     pictures = []
@@ -292,10 +286,10 @@ def main(argv):
         folder = work / r.name
         s = study_runner.read_summary(folder)
         if s is None or not study_runner.matches(s, r.key()):
-            L.append(f"| {fmt_g(r.rate)} | | {fmt_g(r.t_end)} | not run yet | | | |")
+            L.append(f"| {fmt_g(r.rate)} | | {fmt_g(r.t_end)} | not run yet | | |")
             continue
         snaps = snapshots(folder)
-        points, tris = read_vtp(snaps[-1])
+        points, tris = read_vtp(snaps[0])  # as placed: the cell's area at rest
         D_r = math.sqrt(area(points, tris) / math.pi)
         chi = D_r / DIAMETER
         gamma_star = r.rate * PLASMA_VISCOSITY * (D_r * 1e-6) ** 3 / BENDING_MODULUS
@@ -304,7 +298,7 @@ def main(argv):
         hist.append((r.rate, t, m))
         last = m[len(m) - max(1, len(m) // 4):]
         mean = last.mean(axis=0)
-        cells = [f"{mean[k]:.3g} [{last[:, k].min():.3g}, {last[:, k].max():.3g}]" for k in range(3)]
+        cells = [f"{mean[k]:.3g} [{last[:, k].min():.3g}, {last[:, k].max():.3g}]" for k in range(2)]
         shape = classify(*mean, offset_range=float(np.ptp(last[:, 0])))
         L.append(f"| {fmt_g(r.rate)} | {gamma_star:.3g} | {fmt_g(r.t_end)} | {' | '.join(cells)} | {shape} |")
         png = fig_dir / f"{r.name}.png"
@@ -317,17 +311,25 @@ def main(argv):
     for r, png, shape, gamma_star in pictures:
         L += [f"![v/D = {fmt_g(r.rate)} 1/s]({fig_dir.name}/{png.name})", ""]
     if chi is not None:
-        L += ["## In the phase diagram of Fedosov, Peltomaki & Gompper (2014)", "",
-              f"Their confinement is chi = D_r / D with D_r = sqrt(A / pi): here D_r = {chi * DIAMETER:.3g} um "
-              f"and chi = {chi:.3g}; their dimensionless rate is gamma* = (v / D) eta D_r^3 / kappa_B "
-              f"(eta = {PLASMA_VISCOSITY:g} Pa s, kappa_B = {BENDING_MODULUS:g} J). Their diagram "
-              "(shared/spec/CELLS_IN_CHANNELS.md section 5 summarises it) has centred, axisymmetric parachutes "
-              "at strong confinement and high rates, and off-centre slippers at weaker confinement and lower "
-              "rates. The runs above sit at:", ""]
+        L += ["## Where the runs lie", "",
+              f"Fedosov, Peltomaki & Gompper (2014) map the shapes on the confinement chi = D_r / D, with "
+              f"D_r = sqrt(A / pi) from the cell's area A at rest (here D_r = {chi * DIAMETER:.3g} um, "
+              f"chi = {chi:.3g}), and the rate gamma* = (v / D) eta D_r^3 / kappa_B (eta = {PLASMA_VISCOSITY:g} Pa s, "
+              f"kappa_B = {BENDING_MODULUS:g} J); the runs above sit at:", ""]
         for r, png, shape, gamma_star in pictures:
-            L.append(f"- v/D = {fmt_g(r.rate)} 1/s: (chi, gamma*) = ({chi:.3g}, {gamma_star:.3g}), "
-                     f"a {shape} here.")
+            L.append(f"- v/D = {fmt_g(r.rate)} 1/s (mean velocity {fmt_g(r.rate * DIAMETER * 1e-3)} mm/s): "
+                     f"(chi, gamma*) = ({chi:.3g}, {gamma_star:.3g}), {shape}.")
         L.append("")
+        names = {shape for _, _, shape, _ in pictures}
+        found = ", ".join(f"{fmt_g(r.rate)} 1/s: {shape}" for r, _, shape, _ in pictures)
+        L += [f"Found ({found}). "
+              + ("A slipper appears at no rate of this tube: every steady shape is centred. "
+                 if "slipper" not in names else "")
+              + "Both papers place the axisymmetric parachute at strong confinement and high velocity, as here; "
+              "Guckenberger et al. find croissants and slippers coexisting in a microchannel of about the cell's "
+              "size at low velocities (below about 1 mm/s), the shape chosen by where and how the cell starts, so "
+              "a run from one placement (seed "
+              f"{SEED}) shows one of the two.", ""]
     doc.write_text("\n".join(L))
     print(f"wrote {study_runner.rel(doc)} and {study_runner.rel(fig_dir)}/")
     return 0

@@ -1,7 +1,7 @@
 """The shape measures of scripts/tube_shapes.py on shapes whose answer is known: an axisymmetric
-cup on the axis (offset 0, roundness 1, tilt 0), the same cup moved off the axis and turned, a
-long body (its axis of symmetry is its long one), a mesh whose vertices crowd on one side (the
-measures are the surface's), and the reading of a .vtp as the flow command writes it."""
+cup on the axis (offset 0, roundness 1), the same cup moved off the axis and turned, a
+cup flattened across the flow, the surface moments against an exact quadrature, a mesh whose vertices
+crowd on one side (the measures are the surface's), and the reading of a .vtp as the flow command writes it."""
 import math
 import sys
 from pathlib import Path
@@ -49,32 +49,50 @@ def turned(points, degrees, shift):
 
 
 def test_centred_axisymmetric_cup_is_a_parachute():
-    offset, roundness, tilt = tube_shapes.measures(*cup(), radius=5.0)
+    offset, roundness = tube_shapes.measures(*cup(), radius=5.0)
     assert abs(offset) < 1e-12
     assert abs(roundness - 1) < 1e-12
-    assert tilt < 1e-6
-    assert tube_shapes.classify(offset, roundness, tilt, offset_range=0.0) == "parachute"
+    assert tube_shapes.classify(offset, roundness, offset_range=0.0) == "parachute"
 
 
-def test_offset_and_tilt_of_a_moved_and_turned_cup():
+def test_offset_of_a_moved_and_turned_cup_is_a_slipper():
     points, tris = cup()
-    offset, roundness, tilt = tube_shapes.measures(turned(points, 30, [7.0, 1.2, -1.6]), tris, radius=5.0)
-    # the vertex mean and the surface centroid of the cup differ along its axis (x before the turn),
-    # which the turn by 30 deg about y moves into z: the offset is that of the surface centroid
-    c, _ = tube_shapes.surface_moments(turned(points, 30, [7.0, 1.2, -1.6]), tris)
+    moved = turned(points, 30, [7.0, 1.2, -1.6])
+    offset, roundness = tube_shapes.measures(moved, tris, radius=5.0)
+    # the vertex mean and the surface centroid of the cup differ along its axis, which the turn by
+    # 30 deg about y tilts into z: the offset is that of the surface centroid
+    c, _ = tube_shapes.surface_moments(moved, tris)
     assert abs(offset - math.hypot(c[1], c[2]) / 5.0) < 1e-12
     assert abs(offset - 0.4) < 0.05  # |(1.2, -1.6)| = 2, up to that shift
-    assert abs(tilt - 30) < 1e-9
     assert roundness < 0.99
-    assert tube_shapes.classify(offset, roundness, tilt, offset_range=0.0) == "slipper"
-    assert tube_shapes.classify(offset, roundness, tilt, offset_range=0.2) == "not steady"
+    assert tube_shapes.classify(offset, roundness, offset_range=0.0) == "slipper"
+    assert tube_shapes.classify(offset, roundness, offset_range=0.2) == "not steady"
 
 
-def test_tilt_follows_the_axis_of_symmetry_of_a_long_body():
-    # the short-axis reading would give 90 deg for a cigar along the flow: the symmetry axis is its long one
+def test_centred_cup_flattened_across_the_flow_is_a_croissant():
+    points, tris = cup()
+    points[:, 2] *= 0.7
+    offset, roundness = tube_shapes.measures(points, tris, radius=5.0)
+    assert offset < 1e-12
+    assert abs(roundness - 0.7) < 0.05  # z squeezed by 0.7: about 0.7 (the triangles' areas change too)
+    assert tube_shapes.classify(offset, roundness, offset_range=0.0) == "croissant"
+
+
+def test_surface_moments_of_a_cigar_are_exact_for_its_flat_triangles():
+    # the edge-midpoint rule, A/3 times the sum over the three edge midpoints, integrates every
+    # quadratic exactly over a triangle: the closed form must agree to round-off
     points, tris = cigar()
-    assert tube_shapes.measures(points, tris, radius=5.0)[2] < 1e-6
-    assert abs(tube_shapes.measures(turned(points, 20, [0, 0, 0]), tris, radius=5.0)[2] - 20) < 1e-9
+    c, cov = tube_shapes.surface_moments(points, tris)
+    total, first, second = 0.0, np.zeros(3), np.zeros((3, 3))
+    for t in tris:
+        a, b, d = points[t]
+        w = 0.5 * np.linalg.norm(np.cross(b - a, d - a))
+        for m in ((a + b) / 2, (b + d) / 2, (d + a) / 2):
+            first += w / 3 * m
+            second += w / 3 * np.outer(m, m)
+        total += w
+    assert np.allclose(c, first / total, rtol=0, atol=1e-12)
+    assert np.allclose(cov, second / total - np.outer(first, first) / total**2, rtol=0, atol=1e-12)
 
 
 def test_measures_do_not_depend_on_where_the_vertices_crowd():
