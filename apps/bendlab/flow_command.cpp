@@ -88,7 +88,7 @@ void flow(FlowArgs& a) {
   std::cout << result.summary.dump() << std::endl;
 }
 
-const CommandRegistration registration([](CLI::App& app) {
+const CommandRegistration flow_registration([](CLI::App& app) {
   auto args = std::make_shared<FlowArgs>();
   FlowRunSpec& s = args->spec;
   auto* cmd = app.add_subcommand(

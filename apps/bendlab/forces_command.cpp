@@ -85,7 +85,7 @@ void run_forces(const ForcesArgs& a) {
   if (r.energy) note(fmt::format("bending energy E_B = {:.12g}", *r.energy));
 }
 
-const CommandRegistration registration([](CLI::App& app) {
+const CommandRegistration forces_registration([](CLI::App& app) {
   auto args = std::make_shared<ForcesArgs>();
   auto* cmd = app.add_subcommand("forces", "Compute normals, H, K, Lap H, force density f and node force F "
                                            "of one bending method at every vertex");

@@ -63,7 +63,7 @@ void run_mesh(const MeshArgs& a) {
   std::cout << summary.dump() << std::endl;
 }
 
-const CommandRegistration registration([](CLI::App& app) {
+const CommandRegistration mesh_registration([](CLI::App& app) {
   auto args = std::make_shared<MeshArgs>();
   auto* cmd = app.add_subcommand("mesh", "Generate a mesh of the paper's families (MT1, MT2, octahedron, "
                                          "Rivara passes) or the irregular family and map it to a sphere, RBC "

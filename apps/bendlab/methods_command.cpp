@@ -75,7 +75,7 @@ void print_table() {
                "(the others are NaN)\n";
 }
 
-const CommandRegistration registration([](CLI::App& app) {
+const CommandRegistration methods_registration([](CLI::App& app) {
   auto json = std::make_shared<bool>(false);
   auto* cmd = app.add_subcommand("methods", "List the bending methods: name, description, options (with type, "
                                             "range, default) and capabilities");

@@ -129,7 +129,7 @@ std::vector<std::string> split_list(const std::string& s) {
   return items;
 }
 
-const CommandRegistration registration([](CLI::App& app) {
+const CommandRegistration rbc_registration([](CLI::App& app) {
   auto args = std::make_shared<RbcArgs>();
   auto families = std::make_shared<std::string>("mt1,mt2,octa,inhomogeneous,irregular");
   auto methods = std::make_shared<std::string>(method_names_joined(","));

@@ -41,7 +41,7 @@ void run_shape(const ShapeArgs& a) {
   }
 }
 
-const CommandRegistration registration([](CLI::App& app) {
+const CommandRegistration shape_registration([](CLI::App& app) {
   auto args = std::make_shared<ShapeArgs>();
   auto* cmd = app.add_subcommand("shape", "Write the exact normal, H, K, Lap H and force density of an analytic "
                                           "surface at the nodes of a mesh (nodes must lie on the surface)");

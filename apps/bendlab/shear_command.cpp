@@ -130,7 +130,7 @@ void shear(const ShearArgs& a) {
   if (a.plot) plot(a);
 }
 
-const CommandRegistration registration([](CLI::App& app) {
+const CommandRegistration shear_registration([](CLI::App& app) {
   auto args = std::make_shared<ShearArgs>();
   auto* cmd = app.add_subcommand("shear", "Simulate a capsule (neo-Hookean or Skalak membrane plus bending; "
                                           "initially a sphere, or a red blood cell or spheroid with --shape) in "

@@ -203,7 +203,7 @@ void stretch(StretchArgs& a) {
             << std::endl;
 }
 
-const CommandRegistration registration([](CLI::App& app) {
+const CommandRegistration stretch_registration([](CLI::App& app) {
   auto args = std::make_shared<StretchArgs>();
   StretchSpec& s = args->spec;
   s.forces_pN = {0, 25, 50, 75, 100, 125, 150, 175, 193};

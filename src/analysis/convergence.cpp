@@ -7,10 +7,11 @@
 #include <numeric>
 #include <tuple>
 
+#include "bendlab/core/types.hpp"
+
 namespace bendlab {
 
 namespace {
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 bool usable(double h, double e) { return std::isfinite(h) && h > 0 && std::isfinite(e) && e > 0; }
 

@@ -7,7 +7,6 @@
 namespace bendlab {
 
 namespace {
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 void check_scale(double scale) {
   if (!(scale > 0) || !std::isfinite(scale))

@@ -17,7 +17,6 @@ namespace {
 using Vec5 = Eigen::Matrix<double, 5, 1>;
 using Mat5 = Eigen::Matrix<double, 5, 5>;
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 /// The paraboloid has 5 unknowns (the node value is fixed), section 2.4.3.
 constexpr int kMinNeighbours = 5;
 /// Smallest admissible ratio min_k L_kk^2 / max_k M_kk of the Cholesky factor L of the 5 x 5

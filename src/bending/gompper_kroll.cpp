@@ -10,11 +10,6 @@ namespace bendlab {
 
 namespace {
 
-inline Vec3 xrow(const Points& x, int i) { return Vec3(x(i, 0), x(i, 1), x(i, 2)); }
-
-// Below this many faces a call takes a few microseconds and starting threads costs more than it saves.
-constexpr int kParallelMinFaces = 4096;
-
 // Per-vertex sums of eq. (A.2): S_i = sum_j T_ij (x_i - x_j) and D_i = sum_j T_ij l_ij^2 = 8 A_i.
 struct VertexSums {
   Points S;
@@ -23,7 +18,7 @@ struct VertexSums {
 };
 
 // Scratch arrays of the kernel.
-struct KernelScratch {
+struct GompperKrollScratch {
   std::vector<double> half_T, us, corner_grad, m;
 };
 
@@ -64,7 +59,7 @@ struct KernelScratch {
 //   u_i = 4 S_i / D_i + (lambda / (2 kB) - 2 c0) sigma_i S_i / |S_i|,   s_i = 2 |S_i|^2 / D_i^2 - c0^2 / 2,
 // lambda / kB = alpha pi (M - M0) / A. Plain parameters keep the expressions above.
 double gk_kernel(const Topology& t, const Points& x, const BendingParameters& p, Points* force, VertexSums* sums,
-                 KernelScratch& ws) {
+                 GompperKrollScratch& ws) {
   const double kappa_b = p.kappa_b;
   const bool plain = p.plain();
   const int nf = t.num_faces(), nv = t.num_vertices(), ne = t.num_edges();
@@ -100,11 +95,11 @@ double gk_kernel(const Topology& t, const Points& x, const BendingParameters& p,
   double* corner_grad = ws.corner_grad.data();
   double energy = 0;
 
-#pragma omp parallel if (nf >= kParallelMinFaces)
+#pragma omp parallel if (nf >= kBendingParallelMinFaces)
   {
 #pragma omp for schedule(static)
     for (int f = 0; f < nf; ++f) {
-      const Vec3 p[3] = {xrow(x, F(f, 0)), xrow(x, F(f, 1)), xrow(x, F(f, 2))};
+      const Vec3 p[3] = {row(x, F(f, 0)), row(x, F(f, 1)), row(x, F(f, 2))};
       const double inv_A2 = 1.0 / (p[1] - p[0]).cross(p[2] - p[0]).norm();
       for (int k = 0; k < 3; ++k) {
         const int e = FE(f, k);
@@ -114,13 +109,13 @@ double gk_kernel(const Topology& t, const Points& x, const BendingParameters& p,
     }
 #pragma omp for schedule(static) reduction(+ : energy)
     for (int i = 0; i < nv; ++i) {
-      const Vec3 xi = xrow(x, i);
+      const Vec3 xi = row(x, i);
       Vec3 S = Vec3::Zero();
       double D = 0;
       for (int r = roff[i]; r < roff[i + 1]; ++r) {
         const int e = redges[r];
         const double T = half_T[2 * e] + half_T[2 * e + 1];
-        const Vec3 d = xi - xrow(x, rverts[r]);
+        const Vec3 d = xi - row(x, rverts[r]);
         S += T * d;
         D += T * d.squaredNorm();
       }
@@ -139,8 +134,8 @@ double gk_kernel(const Topology& t, const Points& x, const BendingParameters& p,
         Vec3 N = Vec3::Zero();  // area-weighted normal (times 2)
         for (int r = roff[i]; r < roff[i + 1]; ++r) {
           const int f = rfaces[r];
-          const Vec3 p0 = xrow(x, F(f, 0));
-          N += (xrow(x, F(f, 1)) - p0).cross(xrow(x, F(f, 2)) - p0);
+          const Vec3 p0 = row(x, F(f, 0));
+          N += (row(x, F(f, 1)) - p0).cross(row(x, F(f, 2)) - p0);
         }
         const double sn = std::sqrt(S2);
         mh[i] = (S.dot(N) < 0 ? -0.25 : 0.25) * sn;
@@ -176,7 +171,7 @@ double gk_kernel(const Topology& t, const Points& x, const BendingParameters& p,
         double s[3];
         for (int k = 0; k < 3; ++k) {
           v[k] = F(f, k);
-          p[k] = xrow(x, v[k]);
+          p[k] = row(x, v[k]);
           u[k] = Vec3(us[4 * v[k]], us[4 * v[k] + 1], us[4 * v[k] + 2]);
           s[k] = us[4 * v[k] + 3];
         }
@@ -208,7 +203,7 @@ double gk_kernel(const Topology& t, const Points& x, const BendingParameters& p,
       const double scale = -0.5 * kappa_b;  // F = -dE/dx, E = kB/2 sum_i E~_i (eq. (A.1))
 #pragma omp for schedule(static)
       for (int i = 0; i < nv; ++i) {
-        const Vec3 xi = xrow(x, i);
+        const Vec3 xi = row(x, i);
         const Vec3 ui(us[4 * i], us[4 * i + 1], us[4 * i + 2]);
         const double si = us[4 * i + 3];
         Vec3 g = Vec3::Zero();
@@ -217,7 +212,7 @@ double gk_kernel(const Topology& t, const Points& x, const BendingParameters& p,
           const double* cg = &corner_grad[9 * f + 3 * k];
           const double T = half_T[2 * e] + half_T[2 * e + 1];
           const Vec3 uj(us[4 * j], us[4 * j + 1], us[4 * j + 2]);
-          g += Vec3(cg[0], cg[1], cg[2]) + T * (ui - uj - 2.0 * (si + us[4 * j + 3]) * (xi - xrow(x, j)));
+          g += Vec3(cg[0], cg[1], cg[2]) + T * (ui - uj - 2.0 * (si + us[4 * j + 3]) * (xi - row(x, j)));
         }
         force->row(i) = (scale * g).transpose();
       }
@@ -232,7 +227,7 @@ double gk_kernel(const Topology& t, const Points& x, const BendingParameters& p,
 // from call to call, so a time loop does not allocate (and page in) fresh memory at every step
 // (method_workspace.hpp).
 struct GompperKroll::Workspace {
-  KernelScratch kernel;
+  GompperKrollScratch kernel;
   VertexSums sums;
   MeshGeometry geometry;
 };

@@ -10,18 +10,13 @@ namespace bendlab {
 
 namespace {
 
-inline Vec3 xrow(const Points& x, int i) { return Vec3(x(i, 0), x(i, 1), x(i, 2)); }
-
-// Below this many faces a call takes microseconds and starting threads costs more than it saves.
-constexpr int kParallelMinFaces = 4096;
-
 // Per-vertex sums of one shape: M_i = sum_e l_e theta_e and the barycentric area A_i.
 struct Sums {
   Scalars M, A;
 };
 
 // The kernel's arrays (reused from call to call).
-struct KernelScratch {
+struct JulicherScratch {
   Points normal;  // unit face normals
   Scalars area;   // face areas
   Scalars len, theta;
@@ -54,7 +49,7 @@ struct KernelScratch {
 // lambda = alpha pi kB (M - M0) / A (BendingParameters::ade_lambda). Plain parameters keep the
 // expressions above, operation for operation.
 // Returns the energy; fills *force when given; the per-vertex sums are left in ws.sums.
-double kernel(const Topology& t, const Points& x, const BendingParameters& p, Points* force, KernelScratch& ws) {
+double kernel(const Topology& t, const Points& x, const BendingParameters& p, Points* force, JulicherScratch& ws) {
   const double kappa_b = p.kappa_b;
   const bool plain = p.plain();
   const int nf = t.num_faces(), nv = t.num_vertices(), ne = t.num_edges();
@@ -80,13 +75,13 @@ double kernel(const Topology& t, const Points& x, const BendingParameters& p, Po
   s.M.resize(nv);
   s.A.resize(nv);
   double energy = 0;
-  const bool par = nf >= kParallelMinFaces;
+  const bool par = nf >= kBendingParallelMinFaces;
 
 #pragma omp parallel if (par)
   {
 #pragma omp for schedule(static)
     for (int f = 0; f < nf; ++f) {
-      const Vec3 p0 = xrow(x, F(f, 0)), p1 = xrow(x, F(f, 1)), p2 = xrow(x, F(f, 2));
+      const Vec3 p0 = row(x, F(f, 0)), p1 = row(x, F(f, 1)), p2 = row(x, F(f, 2));
       const Vec3 m = (p1 - p0).cross(p2 - p0);
       const double l = m.norm();
       area[f] = 0.5 * l;
@@ -94,7 +89,7 @@ double kernel(const Topology& t, const Points& x, const BendingParameters& p, Po
     }
 #pragma omp for schedule(static)
     for (int e = 0; e < ne; ++e) {
-      const Vec3 d = xrow(x, EV(e, 1)) - xrow(x, EV(e, 0));
+      const Vec3 d = row(x, EV(e, 1)) - row(x, EV(e, 0));
       const double l = d.norm();
       const Vec3 n0 = row(normal, EF(e, 0)), n1 = row(normal, EF(e, 1));
       len[e] = l;
@@ -165,14 +160,14 @@ double kernel(const Topology& t, const Points& x, const BendingParameters& p, Po
         const int a = EV(e, 0), b = EV(e, 1);
         const double w = plain ? kappa_b / 4.0 * (s.M[a] / s.A[a] + s.M[b] / s.A[b])  // w_e
                                : alpha[a] + alpha[b];
-        const Vec3 pa = xrow(x, a), pb = xrow(x, b), d = pb - pa;
+        const Vec3 pa = row(x, a), pb = row(x, b), d = pb - pa;
         const double l = len[e], l2 = l * l;
         Vec3 da = Vec3::Zero(), db = Vec3::Zero(), dok[2];
         for (int k = 0; k < 2; ++k) {
           const int f = EF(e, k);
           const Vec3 nk = row(normal, f);
           const double h = 2.0 * area[f] / l;
-          const double tk = (xrow(x, EO(e, k)) - pa).dot(d) / l2;
+          const double tk = (row(x, EO(e, k)) - pa).dot(d) / l2;
           const Vec3 q = nk / h;
           dok[k] = -q;
           da += (1.0 - tk) * q;
@@ -196,7 +191,7 @@ double kernel(const Topology& t, const Points& x, const BendingParameters& p, Po
           const int f = rfaces[r], k = rcorners[r];
           const int eo = FE(f, k);
           g += EF(eo, 0) == f ? row(go0, eo) : row(go1, eo);
-          const Vec3 dA = 0.5 * row(normal, f).cross(xrow(x, F(f, (k + 2) % 3)) - xrow(x, F(f, (k + 1) % 3)));
+          const Vec3 dA = 0.5 * row(normal, f).cross(row(x, F(f, (k + 2) % 3)) - row(x, F(f, (k + 1) % 3)));
           g -= gface[f] * dA;
         }
         force->row(i) = -g.transpose();
@@ -212,7 +207,7 @@ double kernel(const Topology& t, const Points& x, const BendingParameters& p, Po
 // to call, so a time loop does not allocate (and page in) fresh memory at every step
 // (method_workspace.hpp).
 struct JulicherMethod::Workspace {
-  KernelScratch kernel;
+  JulicherScratch kernel;
   MeshGeometry geometry;
 };
 

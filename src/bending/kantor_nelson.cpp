@@ -17,11 +17,6 @@ inline double theta_over_sin(double theta, double s) {
   return theta < 1e-4 ? 1.0 + theta * theta / 6.0 : theta / s;
 }
 
-inline Vec3 xrow(const Points& x, int i) { return Vec3(x(i, 0), x(i, 1), x(i, 2)); }
-
-// Below this many faces a call takes a few microseconds and starting threads costs more than it saves.
-constexpr int kParallelMinFaces = 4096;
-
 }  // namespace
 
 // Scratch arrays of the force kernel and the geometry of compute(), kept by the method instance
@@ -98,11 +93,11 @@ double KantorNelson::energy_and_forces(const Topology& t, const Points& x, doubl
   auto nrm = [normal](int f) { return Vec3(normal[3 * f], normal[3 * f + 1], normal[3 * f + 2]); };
   double energy = 0;
 
-#pragma omp parallel if (nf >= kParallelMinFaces)
+#pragma omp parallel if (nf >= kBendingParallelMinFaces)
   {
 #pragma omp for schedule(static)
     for (int f = 0; f < nf; ++f) {
-      const Vec3 p0 = xrow(x, F(f, 0)), p1 = xrow(x, F(f, 1)), p2 = xrow(x, F(f, 2));
+      const Vec3 p0 = row(x, F(f, 0)), p1 = row(x, F(f, 1)), p2 = row(x, F(f, 2));
       const Vec3 m = (p1 - p0).cross(p2 - p0);
       const double len = m.norm();
       inv_len[f] = 1.0 / len;
@@ -139,7 +134,7 @@ double KantorNelson::energy_and_forces(const Topology& t, const Points& x, doubl
       for (int r = roff[i]; r < roff[i + 1]; ++r) {
         const int f = rfaces[r], k = rcorners[r];
         const Vec3 w(W[3 * f], W[3 * f + 1], W[3 * f + 2]);
-        s += (xrow(x, F(f, (k + 1) % 3)) - xrow(x, F(f, (k + 2) % 3))).cross(w);
+        s += (row(x, F(f, (k + 1) % 3)) - row(x, F(f, (k + 2) % 3))).cross(w);
       }
       force.row(i) = -s.transpose();
     }
@@ -157,11 +152,11 @@ std::optional<double> KantorNelson::energy(const Topology& t, const Points& x, d
   const IndexPairs& EF = t.edge_faces();
   const double kt = std::sqrt(3.0) * kappa_b;
   auto unit_normal = [&](int f) {
-    const Vec3 p0 = xrow(x, F(f, 0)), p1 = xrow(x, F(f, 1)), p2 = xrow(x, F(f, 2));
+    const Vec3 p0 = row(x, F(f, 0)), p1 = row(x, F(f, 1)), p2 = row(x, F(f, 2));
     return Vec3((p1 - p0).cross(p2 - p0).normalized());
   };
   double energy = 0;
-#pragma omp parallel for schedule(static) reduction(+ : energy) if (t.num_faces() >= kParallelMinFaces)
+#pragma omp parallel for schedule(static) reduction(+ : energy) if (t.num_faces() >= kBendingParallelMinFaces)
   for (int e = 0; e < ne; ++e) {
     const Vec3 n0 = unit_normal(EF(e, 0)), n1 = unit_normal(EF(e, 1));
     if (small_angle_) {

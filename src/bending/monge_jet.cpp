@@ -19,7 +19,6 @@ namespace bendlab {
 
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 /// Smallest admissible ratio min_k L_kk^2 / max_k M_kk of the Cholesky factor L of the scaled
 /// normal matrix M: below it the support is taken not to determine the jet. The scaled design
 /// matrices of the paper's meshes have condition numbers 5e2-4e3 (the spec), so M's are below

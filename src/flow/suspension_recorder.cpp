@@ -22,7 +22,6 @@ namespace {
 constexpr const char* kSeries = "timeseries.csv";
 constexpr const char* kCells = "cells.csv";
 constexpr const char* kProfiles = "profiles.csv";
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // The series' columns whose steady means go into the summary, with their keys.
 struct SummaryColumn {

@@ -8,7 +8,6 @@
 using namespace bendlab;
 
 namespace {
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // Exact fields at three nodes, with round numbers so that the expected errors are exact.
 SurfaceFields three_nodes() {

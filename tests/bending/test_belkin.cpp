@@ -12,12 +12,13 @@
 #include "bendlab/mesh/generators.hpp"
 #include "bendlab/surfaces/analytic_surface.hpp"
 #include "bending/rbc_test_support.hpp"
+#include "bending/shape_test_support.hpp"
 
 using namespace bendlab;
+using test_support::some_rotation;
+using test_support::rbc_points;
 
 namespace {
-
-Points rbc_points(const TriMesh& unit_sphere) { return make_rbc()->map_from_unit_sphere(unit_sphere.positions()); }
 
 // Eq. (13) exactly as printed (sum over triangles, then over their corners, exp of every term,
 // no lumping, no cut-off), with the div-grad sign and the half-space rule: the reference the
@@ -41,11 +42,6 @@ Scalars belkin_by_triangles(const Topology& t, const Points& x, const Scalars& w
     out[i] = s / (4 * M_PI * a * a);
   }
   return out;
-}
-
-Mat3 some_rotation() {
-  return (Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()) * Eigen::AngleAxisd(-1.9, Vec3(0, 1, 0)))
-      .toRotationMatrix();
 }
 
 double mean_abs(const Scalars& v) { return v.cwiseAbs().mean(); }

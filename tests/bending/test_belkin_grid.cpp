@@ -10,12 +10,10 @@
 #include "bendlab/bending/belkin.hpp"
 #include "bendlab/mesh/generators.hpp"
 #include "bendlab/surfaces/analytic_surface.hpp"
+#include "bending/shape_test_support.hpp"
 
 using namespace bendlab;
-
-namespace {
-Points rbc_points(const TriMesh& unit_sphere) { return make_rbc()->map_from_unit_sphere(unit_sphere.positions()); }
-}  // namespace
+using test_support::rbc_points;
 
 namespace {
 double rel_max_diff(const Eigen::MatrixXd& a, const Eigen::MatrixXd& ref) {

@@ -14,15 +14,12 @@
 #include "bendlab/geometry/mesh_geometry.hpp"
 #include "bendlab/mesh/generators.hpp"
 #include "bendlab/surfaces/analytic_surface.hpp"
+#include "bending/shape_test_support.hpp"
 
 using namespace bendlab;
+using test_support::some_rotation;
 
 namespace {
-
-Mat3 some_rotation() {
-  return (Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()) * Eigen::AngleAxisd(-1.9, Vec3(0, 1, 0)))
-      .toRotationMatrix();
-}
 
 /// The graph z = g(x, y) = a x + b y + (alpha x^2 + 2 beta x y + gamma y^2) / 2 in a local frame,
 /// placed in space by the rotation q and the origin o.

@@ -11,8 +11,10 @@
 #include "bendlab/mesh/generators.hpp"
 #include "bendlab/surfaces/analytic_surface.hpp"
 #include "bending/rbc_test_support.hpp"
+#include "bending/shape_test_support.hpp"
 
 using namespace bendlab;
+using test_support::some_rotation;
 
 namespace {
 
@@ -33,11 +35,6 @@ SphereErrors sphere_errors(const TriMesh& m, const BendingResult& r, double radi
     if (ef > e.f_max) e.f_max = ef, e.f_argmax = i;
   }
   return e;
-}
-
-Mat3 some_rotation() {
-  return (Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()) * Eigen::AngleAxisd(-1.9, Vec3(0, 1, 0)))
-      .toRotationMatrix();
 }
 
 }  // namespace

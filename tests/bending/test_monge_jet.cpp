@@ -15,8 +15,10 @@
 #include "bendlab/geometry/mesh_geometry.hpp"
 #include "bendlab/mesh/generators.hpp"
 #include "bendlab/surfaces/analytic_surface.hpp"
+#include "bending/shape_test_support.hpp"
 
 using namespace bendlab;
+using test_support::some_rotation;
 
 namespace {
 
@@ -66,11 +68,6 @@ HeightDerivatives derivatives_of(const Series& h) {
   d.uuuu = h.derivative(4, 0), d.uuuv = h.derivative(3, 1), d.uuvv = h.derivative(2, 2);
   d.uvvv = h.derivative(1, 3), d.vvvv = h.derivative(0, 4);
   return d;
-}
-
-Mat3 some_rotation() {
-  return (Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()) * Eigen::AngleAxisd(-1.9, Vec3(0, 1, 0)))
-      .toRotationMatrix();
 }
 
 /// A generic polynomial graph z = P(x, y) of degree 5 with random coefficients, placed in space by a

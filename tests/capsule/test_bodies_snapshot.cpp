@@ -9,18 +9,11 @@
 #include "bendlab/mesh/generators.hpp"
 #include "bendlab/membrane/membrane_model.hpp"
 #include "bendlab/mesh/mesh_io.hpp"
+#include "file_test_support.hpp"
 
 namespace fs = std::filesystem;
+using bendlab::test_support::slurp;
 using namespace bendlab;
-
-namespace {
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-}  // namespace
 
 TEST(BodiesSnapshot, SeveralBodiesAreOneMeshWithTheirIndex) {
   const TriMesh sphere = icosahedron();

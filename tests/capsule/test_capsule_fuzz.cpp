@@ -28,8 +28,10 @@
 #include "bendlab/flow/bim/bim_capsule_solver.hpp"
 #include "bendlab/mesh/generators.hpp"
 #include "core/byte_mutation.hpp"
+#include "file_test_support.hpp"
 
 namespace fs = std::filesystem;
+using bendlab::test_support::spit;
 using namespace bendlab;
 
 namespace {
@@ -157,8 +159,6 @@ TEST(CapsuleReaderFuzz, EveryMutatedTimeSeriesIsAcceptedOrRefusedWithError) {
 }
 
 namespace {
-
-void spit(const fs::path& p, const std::string& text) { std::ofstream(p, std::ios::binary) << text; }
 
 std::string read_or_empty(const fs::path& p) {
   std::error_code ec;

@@ -18,20 +18,14 @@
 #include "bendlab/core/folder_lock.hpp"
 #include "bendlab/flow/bim/bim_capsule_solver.hpp"
 #include "bendlab/mesh/generators.hpp"
+#include "file_test_support.hpp"
 
 using namespace bendlab;
 namespace fs = std::filesystem;
+using bendlab::test_support::slurp;
+using bendlab::test_support::spit;
 
 namespace {
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-void spit(const fs::path& p, const std::string& text) { std::ofstream(p) << text; }
 
 class CapsuleRun : public ::testing::Test {
  protected:

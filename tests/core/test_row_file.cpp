@@ -9,19 +9,15 @@
 
 #include "bendlab/core/row_file.hpp"
 #include "bendlab/core/types.hpp"
+#include "file_test_support.hpp"
 
 namespace fs = std::filesystem;
+using bendlab::test_support::slurp;
 using namespace bendlab;
 
 namespace {
 fs::path temp(const std::string& name) {
   return fs::temp_directory_path() / ("bendlab_rowfile_" + std::to_string(::getpid()) + "_" + name);
-}
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
 }
 }  // namespace
 

@@ -17,6 +17,10 @@
 
 namespace bendlab {
 
+/// Below this many faces a call of the per-face kernels (Methods A, B, J) takes a few
+/// microseconds, and starting OpenMP threads would cost more than it saves.
+inline constexpr int kBendingParallelMinFaces = 4096;
+
 struct BendingResult {
   Points normal;          ///< N x 3, unit outward normal the method uses (NaN if none)
   Scalars H;              ///< N, mean curvature

@@ -2,6 +2,7 @@
 // Plain array types shared by every module. Per-vertex data are N-row arrays, row-major so
 // that an N x 3 block has the memory layout of a numpy (N, 3) array of float64.
 #include <Eigen/Dense>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -19,6 +20,9 @@ using IndexPairs = Eigen::Matrix<int, Eigen::Dynamic, 2, Eigen::RowMajor>;
 using Scalars = Eigen::VectorXd;
 
 inline Vec3 row(const Points& p, Eigen::Index i) { return p.row(i).transpose(); }
+
+/// The value of a quantity that is not defined (a measure with no data, an unset field).
+inline constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 /// Every error bendlab reports to a user: a one-line message naming the problem.
 class Error : public std::runtime_error {
