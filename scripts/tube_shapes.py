@@ -24,12 +24,16 @@ rate gamma* = (v / D) eta D_r^3 / kappa_B. A tilt of the principal axes is not a
 the three moments of these cups lie within about a quarter of each other, so their axes swing by
 tens of degrees between snapshots without the shape changing; a slipper is told by its offset.
 
-Runs lie under --work (default studies/tube_shapes, kept in git without their fluid states);
-a finished run is not run again (scripts/study_runner.py). Writes docs/results/tube_shapes.md
-and its pictures (docs/results/tube_shapes/).
+Runs lie under --work (default studies/tube_shapes, kept in git without their fluid states and
+snapshots; the measures of the snapshots are kept in each run's shape_measures.json, so the
+document is written again on a fresh checkout, its pictures then left as they are); a finished run
+is not run again (scripts/study_runner.py). Writes docs/results/tube_shapes.md and its pictures
+(docs/results/tube_shapes/).
 """
 import argparse
+import json
 import math
+import os
 import re
 import sys
 import time
@@ -47,7 +51,7 @@ LENGTH = 3 * DIAMETER
 DX = 0.5
 TAU = 1.82
 SEED = 1
-RATES = [400.0, 200.0, 100.0, 50.0]
+RATES = [1600.0, 800.0, 400.0, 200.0, 100.0, 50.0]
 TRAVEL_DIAMETERS = 20.0  # t_end = travel / rate: the cell-free mean velocity covers this many D
 SNAPSHOTS = 40
 PLASMA_VISCOSITY = 1.2e-3   # Pa s, the flow command's default
@@ -145,6 +149,41 @@ def run_measures(folder):
 def area(points, tris):
     a, b, c = points[tris[:, 0]], points[tris[:, 1]], points[tris[:, 2]]
     return 0.5 * float(np.linalg.norm(np.cross(b - a, c - a), axis=1).sum())
+
+
+MEASURES_FILE = "shape_measures.json"
+
+
+def shape_history(folder, t_end):
+    """(t (s), rows (offset, roundness), D_r (um)) of a finished run: measured on its snapshots
+    (evenly spaced over [0, t_end]) and kept in the run folder's shape_measures.json, which is
+    committed with the run; the snapshots are not, so a fresh checkout reads that file instead.
+    None when neither is there."""
+    folder = Path(folder)
+    snaps = snapshots(folder)
+    if snaps:
+        points, tris = read_vtp(snaps[0])  # as placed: the cell's area at rest
+        D_r = math.sqrt(area(points, tris) / math.pi)
+        t = np.linspace(0, t_end, len(snaps))
+        m = run_measures(folder)
+        record = {"D_r_um": D_r, "t_s": t.tolist(), "offset": m[:, 0].tolist(), "roundness": m[:, 1].tolist()}
+        tmp = folder / (MEASURES_FILE + ".tmp")
+        tmp.write_text(json.dumps(record, indent=1) + "\n")
+        os.replace(tmp, folder / MEASURES_FILE)
+        return t, m, D_r
+    record = study_runner.read_json(folder / MEASURES_FILE)
+    if not isinstance(record, dict):
+        return None
+    m = np.column_stack([record["offset"], record["roundness"]])
+    return np.array(record["t_s"]), m, float(record["D_r_um"])
+
+
+def roundness_drift(travelled, roundness):
+    """How much the roundness changes per 10 tube diameters travelled: the slope of its
+    least-squares line against the distance travelled (in D), times 10."""
+    if len(travelled) < 2:
+        return 0.0
+    return 10.0 * float(np.polyfit(travelled, roundness, 1)[0])
 
 
 def classify(offset, roundness, offset_range):
@@ -277,39 +316,49 @@ def main(argv):
           "(offset < 0.1) and round across the flow (roundness > 0.9) is a parachute; centred but two-fold "
           "rather than axially symmetric is a croissant; off the axis is a slipper; an offset still moving by "
           "more than 0.05 over the last quarter is not steady.", ""]
-    L += ["| v / D (1/s) | gamma* | t_end (s) | offset / (D/2) | roundness | shape |",
-          "| --- | --- | --- | --- | --- | --- |"]
+    L += ["| v / D (1/s) | gamma* | t_end (s) | offset / (D/2) | roundness | roundness drift per 10 D | shape |",
+          "| --- | --- | --- | --- | --- | --- | --- |"]
     hist = []
+    drifts = []
     chi = None
     pictures = []
     for r in runs:
         folder = work / r.name
-        s = study_runner.read_summary(folder)
-        if s is None or not study_runner.matches(s, r.key()):
-            L.append(f"| {fmt_g(r.rate)} | | {fmt_g(r.t_end)} | not run yet | | |")
+        state, info = runner.state(r)
+        if state != "done":
+            said = f"failed: {info}" if state == "failed" else "not finished"
+            L.append(f"| {fmt_g(r.rate)} | | {fmt_g(r.t_end)} | {said} | | | |")
             continue
-        snaps = snapshots(folder)
-        points, tris = read_vtp(snaps[0])  # as placed: the cell's area at rest
-        D_r = math.sqrt(area(points, tris) / math.pi)
+        measured = shape_history(folder, r.t_end)
+        if measured is None:
+            L.append(f"| {fmt_g(r.rate)} | | {fmt_g(r.t_end)} | finished, but neither its snapshots nor its "
+                     f"{MEASURES_FILE} are here | | | |")
+            continue
+        t, m, D_r = measured
         chi = D_r / DIAMETER
         gamma_star = r.rate * PLASMA_VISCOSITY * (D_r * 1e-6) ** 3 / BENDING_MODULUS
-        m = run_measures(folder)
-        t = np.linspace(0, r.t_end, len(snaps))
         hist.append((r.rate, t, m))
         last = m[len(m) - max(1, len(m) // 4):]
         mean = last.mean(axis=0)
         cells = [f"{mean[k]:.3g} [{last[:, k].min():.3g}, {last[:, k].max():.3g}]" for k in range(2)]
         shape = classify(*mean, offset_range=float(np.ptp(last[:, 0])))
-        L.append(f"| {fmt_g(r.rate)} | {gamma_star:.3g} | {fmt_g(r.t_end)} | {' | '.join(cells)} | {shape} |")
+        drift = roundness_drift(t[len(t) - len(last):] * r.rate, last[:, 1])  # t v / D: diameters travelled
+        drifts.append((r.rate, drift, float(mean[1])))
+        L.append(f"| {fmt_g(r.rate)} | {gamma_star:.3g} | {fmt_g(r.t_end)} | {' | '.join(cells)} | {drift:+.3f} "
+                 f"| {shape} |")
         png = fig_dir / f"{r.name}.png"
-        picture(png, folder, f"v/D = {fmt_g(r.rate)} 1/s: {shape}")
+        if snapshots(folder):
+            picture(png, folder, f"v/D = {fmt_g(r.rate)} 1/s: {shape}")
+        elif not png.exists():
+            print(f"note: no snapshots of {r.name} here and no picture made before: {study_runner.rel(png)} is missing")
         pictures.append((r, png, shape, gamma_star))
     L.append("")
     if hist:
         history(fig_dir / "history.png", hist)
         L += [f"![the measures against the distance travelled]({fig_dir.name}/history.png)", ""]
     for r, png, shape, gamma_star in pictures:
-        L += [f"![v/D = {fmt_g(r.rate)} 1/s]({fig_dir.name}/{png.name})", ""]
+        if png.exists():
+            L += [f"![v/D = {fmt_g(r.rate)} 1/s]({fig_dir.name}/{png.name})", ""]
     if chi is not None:
         L += ["## Where the runs lie", "",
               f"Fedosov, Peltomaki & Gompper (2014) map the shapes on the confinement chi = D_r / D, with "
@@ -322,7 +371,13 @@ def main(argv):
         L.append("")
         names = {shape for _, _, shape, _ in pictures}
         found = ", ".join(f"{fmt_g(r.rate)} 1/s: {shape}" for r, _, shape, _ in pictures)
+        worst = max(abs(d) for _, d, _ in drifts)
+        near = [f"{fmt_g(rate)} 1/s" for rate, d, rnd in drifts if abs(rnd - 0.9) < abs(d)]
         L += [f"Found ({found}). "
+              f"Over the last quarter of each run the roundness still moves, by up to {worst:.2g} per 10 diameters "
+              "(the drift column: the slope of its least-squares line); "
+              + (f"a name whose roundness lies closer to the parachute's threshold 0.9 than that could change in a "
+                 f"longer run: {', '.join(near)}. " if near else "no roundness lies that close to the threshold 0.9. ")
               + ("A slipper appears at no rate of this tube: every steady shape is centred. "
                  if "slipper" not in names else "")
               + "Both papers place the axisymmetric parachute at strong confinement and high velocity, as here; "

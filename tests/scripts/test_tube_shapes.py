@@ -136,3 +136,32 @@ def test_reads_points_and_triangles_of_a_vtp(tmp_path):
     assert points.shape == (4, 3) and points[3, 2] == 1
     assert tris.tolist() == [[0, 1, 2], [0, 1, 3]]
     assert abs(tube_shapes.area(points, tris) - 1.0) < 1e-15
+
+
+def test_roundness_drift_is_the_slope_per_ten_diameters():
+    travelled = np.linspace(15, 20, 11)
+    assert abs(tube_shapes.roundness_drift(travelled, 0.8 + 0.003 * travelled) - 0.03) < 1e-12
+    assert tube_shapes.roundness_drift(travelled[:1], np.array([0.9])) == 0.0
+
+
+def test_shape_history_is_kept_for_a_checkout_without_snapshots(tmp_path):
+    # the measures of the snapshots go to shape_measures.json; without the snapshots (they are not
+    # committed) the same history is read back from it
+    points, tris = cup()
+    for k, shift in enumerate(([0, 0, 0], [0, 1.0, 0], [0, 0.5, 0.5])):
+        p = points + np.asarray(shift)
+        (tmp_path / f"snapshot_{k:05d}.vtp").write_text(
+            '<VTKFile type="PolyData"><PolyData><Piece>\n'
+            '<Points><DataArray type="Float64" Name="Points" NumberOfComponents="3" format="ascii">\n'
+            + " ".join(f"{v:.17g}" for v in p.ravel()) + "\n</DataArray></Points>\n"
+            '<Polys><DataArray type="Int32" Name="connectivity" format="ascii">\n'
+            + " ".join(str(i) for i in tris.ravel()) + '\n</DataArray><DataArray type="Int64" Name="offsets" format="ascii">\n'
+            + " ".join(str(3 * (i + 1)) for i in range(len(tris))) + "\n</DataArray></Polys></Piece></PolyData></VTKFile>\n")
+    t, m, d_r = tube_shapes.shape_history(tmp_path, 0.2)
+    assert t.tolist() == [0.0, 0.1, 0.2]
+    assert abs(m[1, 0] - 1.0 / 5.0) < 1e-12 and abs(d_r - math.sqrt(tube_shapes.area(points, tris) / math.pi)) < 1e-12
+    for f in tmp_path.glob("*.vtp"):
+        f.unlink()
+    t2, m2, d_r2 = tube_shapes.shape_history(tmp_path, 0.2)
+    assert t2.tolist() == t.tolist() and np.array_equal(m2, m) and d_r2 == d_r
+    assert tube_shapes.shape_history(tmp_path / "nothing", 0.2) is None
