@@ -21,6 +21,7 @@ that failed while stepping (deterministic: a rerun repeats it), failed.json, whi
 from starting it again until the folder is deleted.
 """
 import csv
+import fcntl
 import json
 import math
 import os
@@ -191,6 +192,25 @@ def read_failure(folder, identity):
 
 # ----------------------------------------------------------------------------- commands
 
+def in_use(folder):
+    """Whether another process holds the run folder's lock (the flock() on <folder>/.lock that
+    bendlab takes for the whole of a run, core/folder_lock.hpp). Such a folder is not cleared:
+    deleting it under a running bendlab would let a second run write beside the first."""
+    lock = Path(folder) / ".lock"
+    try:
+        fd = os.open(lock, os.O_RDONLY)
+    except OSError:
+        return False
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        fcntl.flock(fd, fcntl.LOCK_UN)
+        return False
+    except BlockingIOError:
+        return True
+    finally:
+        os.close(fd)
+
+
 def bendlab_binary(path):
     """The `bendlab` executable at `path` (relative to the current folder), as an absolute path;
     exits with a message saying how to build it where there is none."""
@@ -315,6 +335,9 @@ class Runner:
             self.say(f"[{self._next():2d}/{total}] cached   {run.label()}: FAILED ({info}; delete {out} "
                      "to run it again)")
             return Result(run, None, error=info, cached=True)
+        if in_use(out):
+            self.say(f"[{self._next():2d}/{total}] skipped  {run.label()}: its folder {out} is in use by another run")
+            return Result(run, None, error="in use by another run")
         resume = state == "resume"
         if not resume and out.exists():
             shutil.rmtree(out)
@@ -322,7 +345,7 @@ class Runner:
         self.say(f"[  /{total}] {'resume ' if resume else 'start  '}  {run.label()}")
         start = time.monotonic()
         rc, err = self.launch(command(self.bendlab, run, out, resume), out)
-        if rc != 0 and resume and not failed_while_stepping(err):
+        if rc != 0 and resume and not failed_while_stepping(err) and not in_use(out):
             self.say(f"[  /{total}] resume failed, starting over: {run.label()}")
             shutil.rmtree(out)
             out.mkdir(parents=True)

@@ -215,6 +215,36 @@ def test_a_resume_that_fails_at_its_start_starts_over(tmp_path, bendlab, monkeyp
     assert [c[-1] for c in calls(tmp_path)] == ["--resume", "--overwrite"]
 
 
+def test_a_folder_another_run_holds_is_neither_cleared_nor_run(tmp_path, bendlab):
+    # bendlab holds <folder>/.lock with flock() for the whole of a run; a second study process
+    # must not delete that folder (the first run would go on writing beside a second one)
+    import fcntl
+    work = tmp_path / "work"
+    fresh, resumable = Case(0.2), Case(0.1)
+    out = finished_folder(work, fresh, G=0.3)  # another run's files: would be cleared
+    resume_out = work / resumable.name
+    resume_out.mkdir()
+    (resume_out / "checkpoint.json").write_text(json.dumps({"arguments": {"method": "C", "G": 0.1}}))
+    held = []
+    for folder in (out, resume_out):
+        (folder / ".lock").touch()
+        f = open(folder / ".lock")
+        fcntl.flock(f, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        held.append(f)
+    study = runner(bendlab, work)
+    assert sr.in_use(out) and sr.in_use(resume_out) and not sr.in_use(tmp_path)
+    for run in (fresh, resumable):
+        result = study.execute(run)
+        assert not result.ok and result.error == "in use by another run"
+    assert (out / "summary.json").exists() and (resume_out / "checkpoint.json").exists()
+    assert calls(tmp_path) == []
+    assert sum("in use by another run" in m for m in study.messages) == 2
+    for f in held:
+        f.close()
+    assert not sr.in_use(out)
+    assert study.execute(fresh).ok  # released: the folder is run again
+
+
 # ----------------------------------------------------------------------------- failed runs
 
 def test_a_failure_while_stepping_is_recorded_and_not_run_again(tmp_path, bendlab, monkeypatch):
