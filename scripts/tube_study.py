@@ -366,8 +366,12 @@ def write_doc(argv, work, doc, all_parts, binary_commit=None):
 
     L += ["## Cell-free layer beside the literature", "", CELL_FREE_LAYER_LITERATURE + ".", ""]
     total = study_runner.total_wall(s for _, s in have)
+    binaries = {}
+    for r, _ in have:
+        binaries.setdefault(study_runner.binary_of(work / r.name) or "unknown", []).append(r.name)
     L += ["## Run time", "", f"The runs shown took {total:.0f} s of wall time together (one thread each, on a "
-          "machine shared with other work).", ""]
+          "machine shared with other work). The programs that made them, as each run.log's command names it: "
+          + "; ".join(f"`{Path(b).name}` ({', '.join(names)})" for b, names in sorted(binaries.items())) + ".", ""]
     L += ["## Commands", "", "Each run shown, as the script starts it (`--resume` continues one):", "", "```"]
     for r, s in have:
         L.append(" ".join(study_runner.command("bendlab", r, Path("studies/tube") / r.name)))

@@ -362,3 +362,9 @@ def test_the_run_time_table_has_a_row_per_run_and_marks_failed_and_missing_ones(
 def test_the_total_wall_time_leaves_out_unknown_times():
     assert sr.total_wall([{"wall_seconds": 2.0}, None, {"wall_seconds": math.nan}, {"wall_seconds": 3}]) == 5.0
     assert sr.total_wall([]) == 0
+
+
+def test_the_program_of_a_run_is_the_first_word_of_its_latest_command_line(tmp_path):
+    (tmp_path / "run.log").write_text("$ /tmp/old/bendlab shear --out x\nstep 1\n$ '/tmp/new dir/bendlab' shear --resume\nstep 2\n")
+    assert sr.binary_of(tmp_path) == "/tmp/new dir/bendlab"
+    assert sr.binary_of(tmp_path / "none") is None
