@@ -22,6 +22,8 @@
 //                  force, with the interpolated bounce-back of its circular wall. MLUPS counts fluid
 //                  nodes only; its ratio to BM_LbmStepTRTPeriodic's on as many threads is the
 //                  wall cost (target: at least 0.7; scripts/make_lbm_performance_doc.py).
+//   BM_LbmStepTubePlainWalls/<threads>  the same tube with plain halfway bounce-back (no
+//                  interpolation pass): what the interpolated wall costs on top.
 //   BM_MembraneIbm/<threads>  the capsule's part of one IB-LBM step in the paper's full-size case:
 //                  5120 triangles (2562 nodes) of R = 13.5 dx centred in the same 128^3 box,
 //                  neo-Hookean + bending (method A, ESPResSo's tribend) + ESPResSo's volume force,
@@ -203,7 +205,7 @@ void BM_LbmStepTRTPeriodic(benchmark::State& state) {
   }
 }
 
-void BM_LbmStepTube(benchmark::State& state) {
+void lbm_step_tube(benchmark::State& state, bool interpolated) {
   const int threads = static_cast<int>(state.range(0));
   omp_set_num_threads(threads);
   LatticeConfig c;
@@ -214,6 +216,7 @@ void BM_LbmStepTube(benchmark::State& state) {
   c.collision = Collision::TRT;
   c.body_force = Vec3(1e-7, 0, 0);
   c.section = std::make_shared<TubeWall>(25.0);
+  c.interpolated_walls = interpolated;
   Lattice L(c);
   L.run(2);
   for (auto _ : state) L.step();
@@ -222,6 +225,9 @@ void BM_LbmStepTube(benchmark::State& state) {
   state.counters["fluid_nodes"] = static_cast<double>(L.num_fluid_nodes());
   state.counters["wall_link_rows"] = static_cast<double>(L.num_wall_links());
 }
+
+void BM_LbmStepTube(benchmark::State& state) { lbm_step_tube(state, true); }
+void BM_LbmStepTubePlainWalls(benchmark::State& state) { lbm_step_tube(state, false); }
 
 // Measures the triad once per thread count for bound_fraction (not reported by itself).
 void BM_TriadReference(benchmark::State& state) {
@@ -253,6 +259,7 @@ BENCHMARK(BM_LbmStepRegularizedUnpadded)->Arg(1)->Arg(2)->UseRealTime()->Unit(be
 BENCHMARK(BM_MembraneIbm)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_LbmStepTRTPeriodic)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_LbmStepTube)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_LbmStepTubePlainWalls)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
 
 }  // namespace
 
