@@ -569,8 +569,84 @@ bool Lattice::is_solid(std::size_t node) const {
   return solid_rows_[node / static_cast<std::size_t>(config_.nx)] != 0;
 }
 
+namespace {
+
+// Calls body(i, wrap(i - cx, nx)) for i = 0 .. nx - 1 in order, the wrapped end apart, so that
+// the loop over the interior has no wrap and the compiler can vectorise it.
+template <class Body>
+LBM_INLINE void for_row_with_behind(int nx, int cx, Body&& body) {
+  if (cx == 1) {
+    body(0, nx - 1);
+    for (int i = 1; i < nx; ++i) body(i, i - 1);
+  } else if (cx == -1) {
+    for (int i = 0; i < nx - 1; ++i) body(i, i + 1);
+    body(nx - 1, 0);
+  } else {
+    for (int i = 0; i < nx; ++i) body(i, i);
+  }
+}
+
+}  // namespace
+
+// The interpolated bounce-back (Bouzidi et al. 2001, the linear rule) of every wall link, as
+// interpolated_bounce_back_reference computes it node by node, with the link's branches taken
+// once per row: the same arithmetic in the same order, so the same bits.
 void Lattice::apply_interpolated_bounce_back(bool after_odd, int j0, int j1) {
   if (wall_links_.empty() || !config_.interpolated_walls) return;
+  if (config_.reference_wall_pass) return interpolated_bounce_back_reference(after_odd, j0, j1);
+  const int nx = config_.nx, ny = config_.ny;
+  double* f = f_.data();
+  const std::size_t S = stride_;
+  auto row = [&](int j, int k) { return static_cast<std::size_t>(nx) * (static_cast<std::size_t>(j) + static_cast<std::size_t>(ny) * static_cast<std::size_t>(k)); };
+  // Phase 1: every new value from the step's populations (a link's sources may be another link's
+  // target in a gap one node wide, so no write before all are read).
+  double* buf = wall_buffer_.data();
+  for (const WallLink& l : wall_links_) {
+    double* out = buf;
+    buf += nx;
+    if (l.j < j0 || l.j >= j1) continue;
+    const int q = l.q, qb = opposite(q);
+    const double t = l.fraction;
+    const double* target = f + qb * S + row(l.j, l.k);  // f*_q(x_f) after either step (plain bounce-back)
+    const double* own_q = f + q * S + row(l.j, l.k);
+    if (t < 0.5) {
+      if (!l.back_fluid) {
+        for (int i = 0; i < nx; ++i) out[i] = target[i];
+        continue;
+      }
+      const double a = 2.0 * t, b = 1.0 - 2.0 * t;
+      if (after_odd) {
+        for (int i = 0; i < nx; ++i) out[i] = a * target[i] + b * own_q[i];
+      } else {
+        const double* behind = f + qb * S + row(l.jb, l.kb);  // slot qbar of x_b
+        for_row_with_behind(nx, kCx[q], [&](int i, int ib) { out[i] = a * target[i] + b * behind[ib]; });
+      }
+    } else {
+      const double d = 2.0 * t, c = (2.0 * t - 1.0) / (2.0 * t);
+      if (after_odd && l.back_fluid) {
+        const double* reverse = f + qb * S + row(l.jb, l.kb);  // slot qbar of x_b
+        for_row_with_behind(nx, kCx[q], [&](int i, int ib) { out[i] = target[i] / d + c * reverse[ib]; });
+      } else {
+        for (int i = 0; i < nx; ++i) out[i] = target[i] / d + c * own_q[i];
+      }
+    }
+  }
+  // Phase 2: the writes, the rest population taking back the difference (see the reference).
+  buf = wall_buffer_.data();
+  for (const WallLink& l : wall_links_) {
+    const double* in = buf;
+    buf += nx;
+    if (l.j < j0 || l.j >= j1) continue;
+    double* target = f + opposite(l.q) * S + row(l.j, l.k);
+    double* rest = f + row(l.j, l.k);
+    for (int i = 0; i < nx; ++i) {
+      rest[i] -= in[i] - target[i];
+      target[i] = in[i];
+    }
+  }
+}
+
+void Lattice::interpolated_bounce_back_reference(bool after_odd, int j0, int j1) {
   const int nx = config_.nx, ny = config_.ny;
   double* f = f_.data();
   const std::size_t S = stride_;

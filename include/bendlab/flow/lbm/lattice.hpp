@@ -93,6 +93,9 @@ struct LatticeConfig {
   /// false: the section's links keep the plain bounce-back (a staircase wall), the first-order
   /// reference the interpolated one is measured against.
   bool interpolated_walls = true;
+  /// true: the interpolated bounce-back by its plain per-node loop, the reference the fast pass
+  /// (branches hoisted per link, the row's two ends apart) must equal bit for bit (tests).
+  bool reference_wall_pass = false;
 };
 
 class Lattice {
@@ -207,6 +210,7 @@ class Lattice {
   /// The interpolated bounce-back pass after a step (header comment); `after_odd` tells where the
   /// step left its populations.
   void apply_interpolated_bounce_back(bool after_odd, int j0, int j1);
+  void interpolated_bounce_back_reference(bool after_odd, int j0, int j1);
 
   LatticeConfig config_;
   Collision collision_;
