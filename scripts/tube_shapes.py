@@ -118,12 +118,18 @@ def snapshots(folder):
     return sorted(Path(folder).glob("snapshot_*.vtp"))
 
 
+def triangle_areas(points, tris):
+    """The area of each triangle."""
+    a, b, c = points[tris[:, 0]], points[tris[:, 1]], points[tris[:, 2]]
+    return 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1)
+
+
 def surface_moments(points, tris):
     """(centroid, covariance) of the surface itself: the area-weighted first and second moments
     of its flat triangles, exactly (the integral of x x^T over a triangle of area A and vertices
     a, b, c is A (a a^T + b b^T + c c^T + s s^T) / 12 with s = a + b + c)."""
     a, b, c = points[tris[:, 0]], points[tris[:, 1]], points[tris[:, 2]]
-    w = 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1)
+    w = triangle_areas(points, tris)
     s = a + b + c
     total = w.sum()
     centroid = (w[:, None] * s).sum(axis=0) / (3 * total)
@@ -140,15 +146,8 @@ def measures(points, tris, radius):
     return offset, roundness
 
 
-def run_measures(folder):
-    """The measures of every snapshot: rows (offset, roundness)."""
-    rows = [measures(*read_vtp(p), DIAMETER / 2) for p in snapshots(folder)]
-    return np.array(rows).reshape(-1, 2)
-
-
 def area(points, tris):
-    a, b, c = points[tris[:, 0]], points[tris[:, 1]], points[tris[:, 2]]
-    return 0.5 * float(np.linalg.norm(np.cross(b - a, c - a), axis=1).sum())
+    return float(triangle_areas(points, tris).sum())
 
 
 MEASURES_FILE = "shape_measures.json"
@@ -162,10 +161,12 @@ def shape_history(folder, t_end):
     folder = Path(folder)
     snaps = snapshots(folder)
     if snaps:
-        points, tris = read_vtp(snaps[0])  # as placed: the cell's area at rest
+        shapes = (read_vtp(p) for p in snaps)
+        points, tris = next(shapes)  # as placed: the cell's area at rest
         D_r = math.sqrt(area(points, tris) / math.pi)
+        rows = [measures(points, tris, DIAMETER / 2)] + [measures(*shape, DIAMETER / 2) for shape in shapes]
+        m = np.array(rows).reshape(-1, 2)
         t = np.linspace(0, t_end, len(snaps))
-        m = run_measures(folder)
         record = {"D_r_um": D_r, "t_s": t.tolist(), "offset": m[:, 0].tolist(), "roundness": m[:, 1].tolist()}
         tmp = folder / (MEASURES_FILE + ".tmp")
         tmp.write_text(json.dumps(record, indent=1) + "\n")
