@@ -3,6 +3,8 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <memory>
+#include <string>
 
 namespace bendlab::parallel {
 
@@ -19,9 +21,31 @@ int comm_size(MPI_Comm comm) {
   return n;
 }
 
+// The global cross-section seen from a subdomain: local y + shift = global y.
+class ShiftedSection final : public lbm::SectionWalls {
+ public:
+  ShiftedSection(std::shared_ptr<const lbm::SectionWalls> global, double shift) : global_(std::move(global)), shift_(shift) {}
+  bool solid(double y, double z) const override { return global_->solid(y + shift_, z); }
+  double link_fraction(double y, double z, int cy, int cz) const override {
+    return global_->link_fraction(y + shift_, z, cy, cz);
+  }
+  std::string describe() const override { return global_->describe(); }
+
+ private:
+  std::shared_ptr<const lbm::SectionWalls> global_;
+  double shift_;
+};
+
+// Local y + y_shift(...) = global y of the same node (half-integers: exact).
+double y_shift(const lbm::LatticeConfig& global, const SlabDecomposition& s) {
+  return s.begin - 1 + 0.5 * (s.count + 2) - 0.5 * global.ny;
+}
+
 lbm::LatticeConfig local_config(lbm::LatticeConfig c, const SlabDecomposition& s) {
-  if (c.section) throw Error("a tube cross-section is not supported by the parallel lattice yet (run it on one process)");
+  const double shift = y_shift(c, s);
   c.ny = s.count + 2;
+  c.ghost_y_layers = true;
+  if (c.section) c.section = std::make_shared<ShiftedSection>(c.section, shift);
   return c;
 }
 
@@ -47,8 +71,7 @@ Vec3 DistributedLattice::position(int i, int j, int k) const {
 
 void DistributedLattice::initialise(const std::function<Vec3(const Vec3&)>& velocity,
                                     const std::function<double(const Vec3&)>& density) {
-  // Local y + shift = global y (half-integers: exact).
-  const double shift = slab_.begin - 1 + 0.5 * (slab_.count + 2) - 0.5 * global_.ny;
+  const double shift = y_shift(global_, slab_);
   auto to_global = [shift](Vec3 x) {
     x.y() += shift;
     return x;
@@ -62,10 +85,15 @@ void DistributedLattice::initialise_shear_flow() { local_.initialise_shear_flow(
 
 void DistributedLattice::step() {
   const bool even = local_.step_count() % 2 == 0;
-  local_.step_layers(1, slab_.count + 1);
+  local_.collide_stream_layers(1, slab_.count + 1);
   const double t0 = MPI_Wtime();
   exchange(even);
   halo_seconds_ += MPI_Wtime() - t0;
+  // The section's interpolated bounce-back reads populations that stream in from the ghost
+  // layers (after an even step, f*_q(x_f - c_q) sits in the ghost node x_f - c_q; after an odd
+  // one the neighbour pushed it into x_f and the return brought it back), so it runs after the
+  // exchange. It writes only owned nodes' slots that no neighbour reads (lattice.hpp).
+  local_.correct_section_walls(1, slab_.count + 1);
 }
 
 void DistributedLattice::exchange(bool fill) {
@@ -80,7 +108,9 @@ void DistributedLattice::exchange(bool fill) {
       for (int k = 0; k < nz; ++k, b += nx) std::copy_n(at(slots[s], jl, k), nx, b);
   };
   // `masked`: a slot whose source node x - c lies in a wall is written by the owner's own
-  // bounce-back, not by the neighbour: keep it.
+  // bounce-back, not by the neighbour: keep it. So is every slot of a solid row of the section,
+  // which the serial lattice never writes (its checkpoint holds the state at rest there), and a
+  // slot whose source row is solid (bounced back by the owner).
   auto unpack = [&](const int* slots, int jl, const std::vector<double>& buf, bool masked) {
     const double* b = buf.data();
     for (int s = 0; s < kFacePopulations; ++s) {
@@ -88,6 +118,9 @@ void DistributedLattice::exchange(bool fill) {
       for (int k = 0; k < nz; ++k, b += nx) {
         const int ks = k - lbm::kCz[q];
         if (masked && global_.walls && (ks < 0 || ks >= nz)) continue;
+        if (masked && global_.section &&
+            (local_.solid_row(jl, k) || local_.solid_row(jl - lbm::kCy[q], (ks + nz) % nz)))
+          continue;
         std::copy_n(b, nx, at(q, jl, k));
       }
     }
@@ -139,7 +172,8 @@ double DistributedLattice::total_mass() const {
   double m = 0;
   for (int k = 0; k < global_.nz; ++k)
     for (int j = 1; j <= slab_.count; ++j)
-      for (int i = 0; i < global_.nx; ++i) m += local_.density(local_.index(i, j, k));
+      if (!local_.solid_row(j, k))  // fluid nodes only, as Lattice::total_mass
+        for (int i = 0; i < global_.nx; ++i) m += local_.density(local_.index(i, j, k));
   double total = 0;
   MPI_Allreduce(&m, &total, 1, MPI_DOUBLE, MPI_SUM, comm_);
   return total;

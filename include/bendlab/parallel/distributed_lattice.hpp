@@ -10,6 +10,10 @@
 //   odd step (streaming): the owned nodes read the ghost layers and write the populations that
 //     leave the slab into them; afterwards these go back to their owners (return), except the
 //     slots that a wall's bounce-back writes on the owner itself.
+// A cross-section (a tube's or channel's walls, section_walls.hpp) is the global one shifted to
+// the local layers; its interpolated bounce-back runs after the exchange, since it reads
+// populations that stream in from the ghost layers, and the return leaves alone the slots of solid
+// rows and those whose source row is solid (the owner's bounce-back writes them).
 // The owned nodes' slots then equal the serial lattice's at every step, so the fields are the
 // serial solver's bit for bit, and the owned part of the raw store is the global AA layout
 // (a checkpoint is the same file whatever the rank count: distributed_checkpoint.hpp).
@@ -64,7 +68,7 @@ class DistributedLattice {
   /// Wall seconds spent in the halo exchange so far (packing, MPI, unpacking; for benchmarks).
   double halo_seconds() const { return halo_seconds_; }
 
-  /// Sum over all ranks of rho and of sum f c (without F/2) over the owned nodes (collective;
+  /// Sum over all ranks of rho and of sum f c (without F/2) over the owned fluid nodes (collective;
   /// the order of the sum differs from Lattice's).
   double total_mass() const;
 

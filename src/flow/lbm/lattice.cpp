@@ -482,6 +482,7 @@ Lattice::Lattice(const LatticeConfig& config) : config_(config) {
   }
   if (!std::isfinite(config.wall_velocity)) throw Error("LBM wall velocity is not finite");
   if (config.walls && config.nz < 2) throw Error("LBM lattice between walls needs at least 2 layers in z");
+  if (config.ghost_y_layers && config.ny < 3) throw Error("LBM subdomain with ghost layers needs at least 3 layers in y");
   if (!config.body_force.allFinite()) throw Error("LBM body force is not finite");
   if (config.collision == Collision::TRT && !(config.trt_magic > 0 && std::isfinite(config.trt_magic))) {
     throw Error(fmt::format("LBM TRT magic parameter {} must be finite and positive", config.trt_magic));
@@ -519,8 +520,10 @@ void Lattice::build_section() {
   // Every link of a fluid row must reach what the section describes at its unwrapped end (the wall
   // fraction is measured along the unwrapped link); where a periodic wrap finds otherwise, the
   // section does not close inside the box.
+  // Ghost layers (a subdomain's copies of its neighbours' layers) are never stepped: no links.
+  const int jg0 = config_.ghost_y_layers ? 1 : 0, jg1 = config_.ghost_y_layers ? ny - 1 : ny;
   for (int k = 0; k < nz; ++k) {
-    for (int j = 0; j < ny; ++j) {
+    for (int j = jg0; j < jg1; ++j) {
       if (solid_rows_[j + static_cast<std::size_t>(ny) * k]) continue;
       for (int q = 1; q < kQ; ++q) {
         if (kCy[q] == 0 && kCz[q] == 0) continue;
@@ -772,13 +775,24 @@ void Lattice::step_with(const Coll& coll, int j0, int j1) {
     const int r1 = static_cast<int>(static_cast<std::int64_t>(rows) * (t + 1) / nt);
     process_rows(a, r0, r1, coll);
   }
-  apply_interpolated_bounce_back(a.odd, j0, j1);
   ++step_;
 }
 
 void Lattice::step() { step_layers(0, config_.ny); }
 
 void Lattice::step_layers(int j0, int j1) {
+  collide_stream_layers(j0, j1);
+  correct_section_walls(j0, j1);
+}
+
+void Lattice::correct_section_walls(int j0, int j1) {
+  if (j0 < 0 || j1 > config_.ny || j0 >= j1)
+    throw Error(fmt::format("LBM wall pass over layers [{}, {}) outside the lattice's 0..{}", j0, j1, config_.ny));
+  if (step_ == 0) throw Error("LBM wall pass before any step");
+  apply_interpolated_bounce_back((step_ - 1) % 2 == 1, j0, j1);  // where the last step left its populations
+}
+
+void Lattice::collide_stream_layers(int j0, int j1) {
   if (j0 < 0 || j1 > config_.ny || j0 >= j1)
     throw Error(fmt::format("LBM step of layers [{}, {}) outside the lattice's 0..{}", j0, j1, config_.ny));
   const double tau = config_.tau;
@@ -844,6 +858,7 @@ void Lattice::populations_reference(std::size_t node, double f[kQ]) const {
 }
 
 double Lattice::density(std::size_t node) const {
+  if (is_solid(node)) return 1.0;  // the resting wall holds no fluid (lattice.hpp)
   double f[kQ];
   populations(node, f);
   double rho = 0;

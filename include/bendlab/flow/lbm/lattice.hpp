@@ -96,6 +96,10 @@ struct LatticeConfig {
   /// true: the interpolated bounce-back by its plain per-node loop, the reference the fast pass
   /// (branches hoisted per link, the row's two ends apart) must equal bit for bit (tests).
   bool reference_wall_pass = false;
+  /// true: layers j = 0 and ny - 1 are ghost copies of a neighbouring subdomain's layers
+  /// (parallel/distributed_lattice.hpp), never stepped: the section's wall links and its check
+  /// that the section closes inside the box (across the y wrap) then cover the layers between.
+  bool ghost_y_layers = false;
 };
 
 class Lattice {
@@ -170,6 +174,12 @@ class Lattice {
   /// parallel/distributed_lattice.hpp): a stepped layer then never wraps around in y.
   /// step() is step_layers(0, ny()).
   void step_layers(int j0, int j1);
+  /// step_layers in its two parts, for a subdomain whose ghost layers must be exchanged between
+  /// them: collide and stream the layers (the step count advances), then correct the section's
+  /// wall links of those layers to the wall's position (the interpolated bounce-back, which reads
+  /// the populations that stream in from the ghost layers). step_layers is the one, then the other.
+  void collide_stream_layers(int j0, int j1);
+  void correct_section_walls(int j0, int j1);
   void run(std::int64_t steps) {
     for (std::int64_t s = 0; s < steps; ++s) step();
   }
@@ -180,6 +190,9 @@ class Lattice {
   /// The same from the node's coordinates, wall by wall: the reference populations() is tested
   /// against, bit for bit.
   void populations_reference(std::size_t node, double f[kQ]) const;
+  /// rho = sum f; 1 at a node in the solid of the cross-section, which holds no fluid (its slots
+  /// serve the bounce-back of the fluid around it, and after an odd step populations() there
+  /// reads what its fluid neighbours pushed, not a state of the node).
   double density(std::size_t node) const;
   /// u = (sum f c + F/2) / rho with the current force field (and the body force); zero at a node
   /// in the solid of the cross-section (the resting wall, which the immersed boundary then sees).
