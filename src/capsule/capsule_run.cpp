@@ -114,10 +114,10 @@ class Run {
       throw Error(fmt::format("resume: the arguments differ from the run in '{}': {}", folder.string(), diff));
     const bool completing = std::abs(o_.t_end - saved.time) <= kSameTime * std::max(1.0, std::abs(saved.time));
     if (!completing && !(o_.t_end > saved.time))
-      throw Error(fmt::format("resume: t_end (--t-end) {} is before the checkpoint's gamma t = {} in '{}'; a run "
+      throw Error(fmt::format("resume: t_end (--t-end) {} is before the checkpoint's {} = {} in '{}'; a run "
                               "continues to a later end, or to the checkpoint's own to complete its files (start a "
                               "new run in another folder instead)",
-                              o_.t_end, saved.time, folder.string()));
+                              o_.t_end, o_.time_name, saved.time, folder.string()));
     if (saved.solver != solver_.name())
       throw Error(fmt::format("{}: \"solver\" is \"{}\", this run uses \"{}\"", source, saved.solver, solver_.name()));
     solver_.restore_state(saved.positions, saved.time, saved.counters, saved.solver_state.fields, folder, source);
@@ -132,7 +132,7 @@ class Run {
     wall_before_ = state_.wall_seconds;
     note(completing ? fmt::format("the run in '{}' reached t_end = {:g} at its last checkpoint: writing its summary",
                                   folder.string(), o_.t_end)
-                    : fmt::format("resuming at gamma t = {:.4g} from {}", solver_.time(), source));
+                    : fmt::format("resuming at {} = {:.4g} from {}", o_.time_name, solver_.time(), source));
     return completing;
   }
 
@@ -152,9 +152,10 @@ class Run {
       solver_.advance(o_.t_end, [&](const AcceptedStep& s) {
         // Before the step is counted: a step over the budget leaves no row and no checkpoint.
         if (o_.max_steps > 0 && state_.steps >= o_.max_steps)
-          throw Error(fmt::format("more than {} accepted steps (the budget of --max-steps) to reach gamma t = {:g} "
-                                  "(mean gamma dt {:.3g}; the last step {:.3g})",
-                                  o_.max_steps, o_.t_end, s.time / static_cast<double>(state_.steps + 1), s.dt));
+          throw Error(fmt::format("more than {} accepted steps (the budget of --max-steps) to reach {} = {:g} "
+                                  "(mean step {:.3g}; the last step {:.3g})",
+                                  o_.max_steps, o_.time_name, o_.t_end,
+                                  s.time / static_cast<double>(state_.steps + 1), s.dt));
         ++state_.steps;
         ++steps_here;
         last_good_time = s.time;
@@ -180,9 +181,10 @@ class Run {
         return true;
       });
     } catch (const Error& e) {
-      throw Error(fmt::format("the run failed after step {} (gamma t = {:.6g}): {}; the last checkpoint, at gamma t = "
+      throw Error(fmt::format("the run failed after step {} ({} = {:.6g}): {}; the last checkpoint, at {} = "
                               "{:.6g}, is whole in '{}'",
-                              state_.steps, last_good_time, e.what(), state_.time, checkpoint_path_.string()));
+                              state_.steps, o_.time_name, last_good_time, e.what(), o_.time_name, state_.time,
+                              checkpoint_path_.string()));
     }
     return !stopped;
   }

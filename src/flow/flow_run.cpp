@@ -212,6 +212,7 @@ CapsuleRunResult FlowRun::run(CapsuleRunOptions options) {
   nlohmann::json arguments = spec_.to_json();
   for (const auto& [key, value] : options.arguments.items()) arguments[key] = value;
   options.arguments = arguments;
+  options.time_name = "t (s)";
   options.summary_fields["achieved_hematocrit_placed"] = placement_.hematocrit;
   options.summary_fields["relax_steps"] = relax_steps_;
   options.summary_fields["dt_s"] = units_.dt;

@@ -80,6 +80,9 @@ struct CapsuleRunOptions {
   /// Asked after every accepted step; true stops the run as stop_after_steps does (no summary;
   /// resumable from the last checkpoint). How an interactive caller (Ctrl-C in Python) stops.
   std::function<bool()> should_stop;
+  /// How the run's messages name its time: "gamma t" (a shear run's unit) or "t (s)" (a flow
+  /// run's seconds).
+  std::string time_name = "gamma t";
   double progress_interval_seconds = 2;  ///< wall time between progress reports
   /// false on every process of a parallel run but the first (MPI rank 0): the process steps,
   /// checkpoints (solver.save_state is collective) and resumes with the others, but writes no
