@@ -34,6 +34,11 @@ stepping is recorded, not retried (scripts/study_runner.py). Run the parts in th
     OMP_NUM_THREADS=1 nohup /usr/bin/python3 scripts/tube_study.py --only methods > results/tube.log 2>&1 &
 Writes docs/results/tube_flow.md and its figures (docs/results/tube_flow/) from every run that is
 done, and says which are missing.
+
+The net force of each bending method (A, C, D, M) on the cells of a methods run's last snapshot
+(`bendlab forces` on every cell, kappa_B of the run, in pN) is kept in the run's net_force.json
+(the snapshots are not kept in git), beside the driving force per cell; with the runs' figures it
+gives the document's stated answer to which method a suspension should use.
 """
 import argparse
 import math
@@ -149,8 +154,21 @@ def done(r, work):
 
 
 def failure(r, work):
+    """The run's error as the document shows it (without the program's prefix and the checkpoint's
+    path), or None where it did not fail."""
+    import re
     f = study_runner.read_json(work / r.name / "failed.json")
-    return f.get("error") if isinstance(f, dict) else None
+    if not isinstance(f, dict) or not f.get("error"):
+        return None
+    text = f["error"].removeprefix("bendlab: error: ")
+    return re.sub(r"; the last checkpoint, at [^=]+= ([0-9.eE+-]+), is whole in '[^']*'$", "", text)
+
+
+def failed_at(error):
+    """The time (s) a flow run's error names as the last step's, else None."""
+    import re
+    m = re.search(r"the run failed after step \d+ \((?:gamma t|t \(s\)) = ([0-9.eE+-]+)\)", error or "")
+    return float(m.group(1)) if m else None
 
 
 def num(x, digits=4):
@@ -187,7 +205,204 @@ def cell_shapes(work, r, s):
     return float(np.mean(c["D"][sel])), float(np.mean(c["axis_angle_deg"][sel]))
 
 
-def write_doc(argv, work, doc, all_parts, binary_commit=None):
+# ----------------------------------------------------------------------------- net force
+
+# The methods whose force on a run's cells the study evaluates, on the same shapes.
+NET_FORCE_METHODS = ["A", "C", "D", "M"]
+NET_FORCE_FILE = "net_force.json"
+
+
+def run_log_parameters(folder):
+    """kappa_B (J), the body force (N/m^3) and the number of cells, as the run's log states them."""
+    import re
+    try:
+        text = (folder / "run.log").read_text()
+    except OSError:
+        return None
+    kappa = re.search(r"kappa_B = ([-+0-9.eE]+) J", text)
+    force = re.search(r"body force ([-+0-9.eE]+) N/m\^3", text)
+    cells = re.search(r"^cells: (\d+) x", text, re.M)
+    if not (kappa and force and cells):
+        return None
+    return float(kappa.group(1)), float(force.group(1)), int(cells.group(1))
+
+
+def snapshot_times(folder):
+    """{snapshot file name: t (s)} from the run's shapes.pvd."""
+    import re
+    try:
+        text = (folder / "shapes.pvd").read_text()
+    except OSError:
+        return {}
+    return {m.group(2): float(m.group(1)) for m in re.finditer(r'timestep="([^"]+)"[^>]*file="([^"]+)"', text)}
+
+
+def net_force_record(bendlab, work, r):
+    """The net force of each method of NET_FORCE_METHODS on every cell of the run's last snapshot, in pN
+    (`bendlab forces` on each cell, kappa_B in pN um), beside the driving force per cell (the body force
+    times the tube's volume over the number of cells). Kept in the run's net_force.json, so that a
+    checkout without the snapshots writes the same document; None where the run has neither."""
+    import json
+    import subprocess
+    import tempfile
+    from tube_shapes import read_vtp
+    folder = work / r.name
+    cached = study_runner.read_json(folder / NET_FORCE_FILE)
+    vtps = sorted(folder.glob("snapshot_*.vtp"))
+    if isinstance(cached, dict) and (not vtps or cached.get("snapshot") == vtps[-1].name) and \
+            cached.get("methods", {}).keys() == set(NET_FORCE_METHODS):
+        return cached
+    params = run_log_parameters(folder)
+    if not vtps or params is None or bendlab is None:
+        return cached if isinstance(cached, dict) else None
+    kappa_J, body_force, n_cells = params
+    kappa_pN_um = kappa_J * 1e18
+    volume_m3 = math.pi * (0.5e-6 * r.diameter) ** 2 * (r.length_factor * r.diameter * 1e-6)
+    driving_pN = body_force * volume_m3 / n_cells * 1e12
+    pts, tris, body = read_vtp(vtps[-1], with_body=True)
+    rec = {"snapshot": vtps[-1].name, "t_s": snapshot_times(folder).get(vtps[-1].name),
+           "kappa_pN_um": kappa_pN_um, "driving_per_cell_pN": driving_pN, "flow_axis": "x", "methods": {}}
+    with tempfile.TemporaryDirectory() as tmp:
+        meshes = []
+        for c in range(int(body.max()) + 1):
+            idx = np.flatnonzero(body == c)
+            local = tris[body[tris[:, 0]] == c] - idx[0]
+            x = pts[idx] - pts[idx].mean(axis=0)
+            path = Path(tmp) / f"cell_{c}.off"
+            path.write_text(f"OFF\n{len(x)} {len(local)} 0\n" + "".join(f"{a!r} {b!r} {d!r}\n" for a, b, d in x)
+                            + "".join(f"3 {i} {j} {k}\n" for i, j, k in local))
+            meshes.append(path)
+        for m in NET_FORCE_METHODS:
+            net, rms, errors = [], [], []
+            for c, mesh in enumerate(meshes):
+                out = Path(tmp) / f"forces_{m}_{c}.csv"
+                done_ = subprocess.run([str(bendlab), "forces", "--mesh", str(mesh), "--method", m, "--kappa-b",
+                                        repr(kappa_pN_um), "--out", str(out)], capture_output=True, text=True)
+                if done_.returncode != 0:
+                    errors.append(f"cell {c}: {(done_.stderr or done_.stdout).strip().splitlines()[-1]}")
+                    continue
+                f = read_csv(out)
+                F = np.stack([f["Fx"], f["Fy"], f["Fz"]], axis=1)
+                net.append(F.sum(axis=0).tolist())
+                rms.append(float(np.sqrt((F ** 2).sum(axis=1).mean())))
+            rec["methods"][m] = {"net_pN": net, "rms_node_pN": rms, "errors": errors}
+    tmp_file = folder / (NET_FORCE_FILE + ".tmp")
+    tmp_file.write_text(json.dumps(rec, indent=1))
+    tmp_file.replace(folder / NET_FORCE_FILE)
+    return rec
+
+
+def net_force_section(bendlab, work, runs):
+    """The document's lines on the net bending force per cell, from the runs that have a record."""
+    L = []
+    for r in runs:
+        rec = net_force_record(bendlab, work, r)
+        if rec is None:
+            continue
+        t = rec.get("t_s")
+        L += [f"On the cells of the run {r.label()}, at t = {num(t, 3)} s ({rec['snapshot']}); the driving force "
+              f"per cell (body force x tube volume / cells) is {num(rec['driving_per_cell_pN'], 3)} pN:", "",
+              "| method | net force along the flow, mean over cells (pN) | largest net force over cells (pN) | "
+              "largest / driving force per cell | rms node force (pN) | cells it failed on |",
+              "| --- | --- | --- | --- | --- | --- |"]
+        for m in NET_FORCE_METHODS:
+            e = rec["methods"].get(m, {})
+            net = np.array(e.get("net_pN") or np.zeros((0, 3)))
+            if len(net):
+                mag = np.linalg.norm(net, axis=1)
+                L.append(f"| {m} | {num(float(net[:, 0].mean()), 3)} | {num(float(mag.max()), 3)} | "
+                         f"{num(float(mag.max()) / rec['driving_per_cell_pN'], 3)} | "
+                         f"{num(float(np.mean(e['rms_node_pN'])), 3)} | {len(e.get('errors', []))} |")
+            else:
+                L.append(f"| {m} | - | - | - | - | {len(e.get('errors', []))} ({'; '.join(e.get('errors', []))}) |")
+        L.append("")
+    if not L:
+        return []
+    return ["## The net force of the bending force on a cell", "",
+            "Every method's force on the same shapes: each cell of a run's last snapshot, alone (`bendlab forces`, "
+            "kappa_B of the run). A membrane's internal forces must sum to zero on each cell: the continuous "
+            "bending force of a closed surface does, as the variation of an energy that a translation leaves "
+            "unchanged. Method A is the exact gradient of such a discrete energy, so its net force is zero to "
+            "round-off; Methods C, D and M evaluate the continuous force density at the vertices, and their "
+            "discretisation errors need not cancel over a cell. What does not cancel pushes the cell through "
+            "the plasma and the plasma the other way: a force the physics does not have.", ""] + L
+
+
+def answer(bendlab, work, runs):
+    """The stated answer to "does the bending algorithm change what the suspension does, and which
+    should a user pick", from the runs of the methods part and the net forces on their cells."""
+    rows = [(r, done(r, work)) for r in runs]
+    ran = [(r, s) for r, s in rows if s is not None]
+    failed = [(r, failure(r, work)) for r, s in rows if s is None and failure(r, work)]
+    if len(ran) < 2:
+        return []
+    eta = {r.method: mean_se(s, "apparent_viscosity") for r, s in ran}
+    hd = {r.method: mean_se(s, "discharge_hematocrit") for r, s in ran}
+    cfl = {r.method: mean_se(s, "cell_free_layer_um") for r, s in ran}
+    lo = min(eta, key=lambda m: eta[m][0])
+    hi = max(eta, key=lambda m: eta[m][0])
+    z = (eta[hi][0] - eta[lo][0]) / math.hypot(eta[hi][1], eta[lo][1])
+    bending = [m for m in eta if m != "none"]
+    L = ["**The answer.** Yes, beyond the noise: over the methods that ran, eta_app / eta goes from "
+         f"{num(eta[lo][0])} (Method {lo}) to {num(eta[hi][0])} (Method {hi}), {z:.0f} standard errors apart "
+         f"({(eta[hi][0] - eta[lo][0]) / eta[lo][0]:+.1%}); H_D from {num(min(v[0] for v in hd.values()), 3)} to "
+         f"{num(max(v[0] for v in hd.values()), 3)}, the cell-free layer from {num(min(v[0] for v in cfl.values()), 3)} "
+         f"to {num(max(v[0] for v in cfl.values()), 3)} um."]
+    if "none" in eta and bending:
+        spread = max(eta[m][0] for m in bending) - min(eta[m][0] for m in bending)
+        L[-1] += (f" Bending itself moves eta_app by {min(abs(eta[m][0] - eta['none'][0]) for m in bending):.3g} "
+                  f"to {max(abs(eta[m][0] - eta['none'][0]) for m in bending):.3g} from the run without it; the "
+                  f"choice among the bending methods that finished, by {spread:.3g}.")
+    for r, err in failed:
+        t = failed_at(err)
+        L[-1] += (f" Method {r.method} did not finish: it failed at t = {num(t, 3)} s of {num(r.t_end, 3)} s "
+                  f"({err.split(': ')[-1] if ': ' in err else err}).")
+    # The net forces: the largest on any recorded shapes, per method, against the driving force per
+    # cell and against the method's own rms force on a node.
+    worst, own = {}, {}
+    for r in runs:
+        rec = net_force_record(bendlab, work, r)
+        if rec is None:
+            continue
+        for m, e in rec["methods"].items():
+            net = np.array(e.get("net_pN") or np.zeros((0, 3)))
+            if len(net):
+                mag = np.linalg.norm(net, axis=1)
+                worst[m] = max(worst.get(m, 0.0), float(mag.max()) / rec["driving_per_cell_pN"])
+                own[m] = max(own.get(m, 0.0), float(np.max(mag / np.maximum(e["rms_node_pN"], 1e-300))))
+    if worst:
+        L[-1] += (" What the static benchmark cannot show is whether a method's forces on a cell sum to zero: "
+                  "on the shapes of these runs (the section below), the largest net force on a cell is "
+                  + ", ".join(f"{worst[m]:.2g} of the driving force per cell and {own[m]:.2g} times its own rms "
+                              f"node force for Method {m}" for m in sorted(worst))
+                  + " (a sum of 642 node forces of random sign would be about 25 of them; more is a bias).")
+    # What to pick: a method whose net force vanishes (round-off) and that ran; then the others that
+    # ran, with their net force; not those that failed.
+    ran_methods = [m for m in bending]
+    exact = [m for m in ran_methods if worst.get(m, 1.0) < 1e-9]
+    unfit = sorted({r.method for r, _ in failed})
+    usable = [m for m in ran_methods if m not in exact and m not in unfit]
+    pick = []
+    if exact:
+        pick.append(f"a method whose force is the exact gradient of a discrete energy (Method {', '.join(exact)} "
+                    "here; B and J are of the same kind): its net force and torque on every cell vanish by "
+                    "construction")
+    if usable:
+        pick.append(" or ".join(f"Method {m}" + (f" knowing that it can push a cell against the flow with up to "
+                                                 f"{worst[m]:.2g} of the driving force" if m in worst else "")
+                                for m in usable))
+    if pick:
+        L[-1] += (" So, for a suspension at this resolution (1280 triangles, dx = 0.5 um), pick " + "; or ".join(pick)
+                  + ".")
+    if unfit:
+        L[-1] += (" Not Method " + ", ".join(unfit) + " at this resolution: "
+                  + "; ".join(f"{m} failed" + (f", and its net force reached {worst[m]:.2g} of the driving force "
+                                                 "on the shapes below" if m in worst else "") for m in unfit) + ".")
+    L[-1] += " Which figures have converged is the resolution section's question, not this table's."
+    return L + [""]
+
+
+def write_doc(argv, work, doc, all_parts, binary_commit=None, bendlab=None):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -274,6 +489,7 @@ def write_doc(argv, work, doc, all_parts, binary_commit=None):
                          f"errors of the difference)")
         L += ["Against Method C: " + "; ".join(lines) + ". A difference beyond about two standard errors is "
               "one the runs resolve; a smaller one is noise at this run length.", ""]
+    L += answer(bendlab, work, all_parts["methods"])
     # Every finished run against the laws, as the issue's acceptance reads them.
     against = []
     for r, s_ in have:
@@ -364,6 +580,7 @@ def write_doc(argv, work, doc, all_parts, binary_commit=None):
     if pics:
         L += ["## The cells at the end", ""] + [p + "\n" for p in pics]
 
+    L += net_force_section(bendlab, work, all_parts["methods"])
     L += ["## Cell-free layer beside the literature", "", CELL_FREE_LAYER_LITERATURE + ".", ""]
     total = study_runner.total_wall(s for _, s in have)
     binaries = {}
@@ -430,7 +647,8 @@ def main():
         return study_runner.Runner(a.bendlab, work).list(todo, f"part {a.only or 'all'}")
     if todo:
         study_runner.Runner(study_runner.bendlab_binary(a.bendlab), work, jobs=a.jobs, say=say).run_all(todo)
-    write_doc(sys.argv[1:], work, doc, all_parts, a.binary_commit)
+    binary = Path(a.bendlab)
+    write_doc(sys.argv[1:], work, doc, all_parts, a.binary_commit, binary if binary.exists() else None)
     return 0
 
 
