@@ -192,6 +192,21 @@ Vec3 tube_velocity(const Vec3& x) {
   return {0.01 * (1 - (x.y() * x.y() + x.z() * x.z()) / 28.0), 0.004 * std::sin(x.x() + x.z()), 0.003 * std::cos(x.y() - x.x())};
 }
 
+// Both lattices in the same initial state with the same force field.
+void start(lbm::Lattice& serial, DistributedLattice& d) {
+  serial.initialise(tube_velocity);
+  d.initialise(tube_velocity);
+  set_force(serial, serial.config());
+  set_force(d);
+}
+
+void step_both(lbm::Lattice& serial, DistributedLattice& d, int steps) {
+  for (int s = 0; s < steps; ++s) {
+    serial.step();
+    d.step();
+  }
+}
+
 }  // namespace
 
 TEST(DistributedTube, MatchesTheSerialLatticeBitForBitWithInterpolatedWalls) {
@@ -199,22 +214,15 @@ TEST(DistributedTube, MatchesTheSerialLatticeBitForBitWithInterpolatedWalls) {
     const lbm::LatticeConfig c = tube_config(interpolated);
     lbm::Lattice serial(c);
     DistributedLattice d(c, MPI_COMM_WORLD);
-    serial.initialise(tube_velocity);
-    d.initialise(tube_velocity);
-    set_force(serial, c);
-    set_force(d);
+    start(serial, d);
     EXPECT_EQ(field_difference(d, serial), 0.0);
-    for (int s = 0; s < 60; ++s) {
-      serial.step();
-      d.step();
-    }
+    step_both(serial, d, 60);
     lbm::Lattice initial(c);
     initial.initialise(tube_velocity);
     set_force(initial, c);
     EXPECT_GT(field_difference(d, initial), 1e-4) << "interpolated " << interpolated;
     EXPECT_EQ(field_difference(d, serial), 0.0) << "interpolated " << interpolated;
-    serial.step();
-    d.step();
+    step_both(serial, d, 1);
     EXPECT_EQ(field_difference(d, serial), 0.0) << "interpolated " << interpolated << ", odd step";
     EXPECT_NEAR(d.total_mass(), serial.total_mass(), 1e-11 * c.nx * c.ny * c.nz);
   }
@@ -225,14 +233,8 @@ TEST(DistributedTube, CheckpointIsTheSerialFileSolidRowsIncluded) {
   const lbm::LatticeConfig c = tube_config(true);
   lbm::Lattice serial(c);
   DistributedLattice d(c, MPI_COMM_WORLD);
-  serial.initialise(tube_velocity);
-  d.initialise(tube_velocity);
-  set_force(serial, c);
-  set_force(d);
-  for (int s = 0; s < 41; ++s) {
-    serial.step();
-    d.step();
-  }
+  start(serial, d);
+  step_both(serial, d, 41);
   const auto path = folder.path() / "tube.bin";
   write_checkpoint(d, path);
   lbm::Lattice read(c);
