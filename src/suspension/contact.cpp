@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 namespace bendlab {
 
@@ -176,14 +177,23 @@ void ContactSearch::for_each_pair(const Vessel& vessel, const Points& x, const s
 
 double ContactSearch::add_cell_contact(const Vessel& vessel, const ContactLaw& law, const Points& x,
                                        const std::vector<int>& cell_of, Points& F) {
-  double energy = 0;
+  // The pairs are found in bin order, which depends on every vertex's position (the bins of an
+  // axis without a period span the vertices present); they are added in the order of their rows
+  // (i, j) instead, so that a vertex's force is summed over its partners in row order whatever the
+  // other vertices are: a rank that holds only the cells near its own gets the serial force.
+  pairs_.clear();
   for_each_pair(vessel, x, cell_of, law.cutoff, [&](int i, int j, const Vec3& d, double r) {
-    energy += law.energy(r);
-    if (r == 0) return;  // no direction: the neighbours' pushes separate the two
-    const Vec3 f = law.force(r) / r * d;
-    F.row(i) += f.transpose();
-    F.row(j) -= f.transpose();
+    pairs_.push_back(Pair{(static_cast<std::uint64_t>(i) << 32) | static_cast<std::uint32_t>(j), d, r});
   });
+  std::sort(pairs_.begin(), pairs_.end(), [](const Pair& a, const Pair& b) { return a.rows < b.rows; });
+  double energy = 0;
+  for (const Pair& p : pairs_) {
+    energy += law.energy(p.r);
+    if (p.r == 0) continue;  // no direction: the neighbours' pushes separate the two
+    const Vec3 f = law.force(p.r) / p.r * p.d;
+    F.row(static_cast<Eigen::Index>(p.rows >> 32)) += f.transpose();
+    F.row(static_cast<Eigen::Index>(p.rows & 0xffffffffu)) -= f.transpose();
+  }
   return energy;
 }
 

@@ -96,6 +96,37 @@ TEST(ContactSearch, CellListEqualsAllPairsWithPeriodicImages) {
   }
 }
 
+// A vertex's contact force is summed over its partners in row order: a far cell appended to the
+// rows (which moves the bins of the axes without a period) leaves every other force unchanged bit
+// for bit, and so does leaving out a cell that touches no other (rows keep their order). This is
+// what lets a rank of the MPI suspension compute its cells' forces from the nearby cells only.
+TEST(ContactSearch, ForcesDoNotDependOnFarVertices) {
+  for (const Vessel& v : {Vessel::channel(4.0, 3.0, 5.0), Vessel::tube(4.0, 2.5), Vessel::box(2.0, 1.5, 1.2)}) {
+    std::vector<int> cell_of;
+    const Points x = random_cloud(v, 5, 60, cell_of, 13);
+    const ContactLaw law{1.3, 0.45};
+    ContactSearch search;
+    Points F = Points::Zero(x.rows(), 3);
+    search.add_cell_contact(v, law, x, cell_of, F);
+    ASSERT_GT(F.cwiseAbs().maxCoeff(), 0.0) << v.describe();
+    // A sixth cell far beyond the walls, in the middle of the rows' order: cell 2's rows move.
+    const Eigen::Index far_rows = 30, split = 2 * 60;
+    Points y(x.rows() + far_rows, 3);
+    std::vector<int> cell_of_y;
+    for (Eigen::Index i = 0; i < split; ++i) y.row(i) = x.row(i), cell_of_y.push_back(cell_of[i]);
+    for (Eigen::Index k = 0; k < far_rows; ++k) {
+      y.row(split + k) << 0.01 * static_cast<double>(k), 0.02 * static_cast<double>(k), 3.0 * v.height() + 0.03 * static_cast<double>(k);
+      cell_of_y.push_back(9);
+    }
+    for (Eigen::Index i = split; i < x.rows(); ++i) y.row(far_rows + i) = x.row(i), cell_of_y.push_back(cell_of[i]);
+    Points G = Points::Zero(y.rows(), 3);
+    search.add_cell_contact(v, law, y, cell_of_y, G);
+    EXPECT_EQ(G.topRows(split), F.topRows(split)) << v.describe();
+    EXPECT_EQ(G.middleRows(split, far_rows).cwiseAbs().maxCoeff(), 0.0) << v.describe();
+    EXPECT_EQ(G.bottomRows(x.rows() - split), F.bottomRows(x.rows() - split)) << v.describe();
+  }
+}
+
 TEST(ContactSearch, ForcesAreMinusTheEnergyGradient) {
   const Vessel v = Vessel::channel(3.0, 2.0, 2.0);
   std::vector<int> cell_of;

@@ -15,6 +15,7 @@
 // nearest periodic image (the image in the neighbour bin, or Vessel::minimum_image where an axis
 // has fewer than three bins), so positions may be unwrapped. ContactSearch
 // keeps its bins between calls: once warm it allocates nothing.
+#include <cstdint>
 #include <vector>
 
 #include "bendlab/core/types.hpp"
@@ -37,7 +38,10 @@ double add_wall_contact(const Vessel& vessel, const ContactLaw& law, const Point
 class ContactSearch {
  public:
   /// Adds the repulsion between vertices of different cells (cell_of[i]: the cell of row i of x)
-  /// to F; returns the energy summed over the pairs.
+  /// to F; returns the energy summed over the pairs. Each vertex's force is added pair by pair in
+  /// the order of its partners' rows, so it does not depend on vertices beyond the cutoff (nor on
+  /// the bins they make): rows of x that keep their order and their neighbours give the same
+  /// forces bit for bit (the MPI suspension holds only the cells near a rank's slab).
   double add_cell_contact(const Vessel& vessel, const ContactLaw& law, const Points& x,
                           const std::vector<int>& cell_of, Points& F);
   /// The smallest distance between vertices of different cells closer than `range` (range if
@@ -55,6 +59,12 @@ class ContactSearch {
   double lo_[3] = {0, 0, 0}, w_[3] = {1, 1, 1};
   static constexpr int kEmptyBin = -1, kMixedBin = -2;
   std::vector<int> bin_of_, start_, items_, sorted_cell_, bin_cell_;
+  struct Pair {
+    std::uint64_t rows;  // i << 32 | j, i < j
+    Vec3 d;              // x_i - x_j (nearest image)
+    double r;
+  };
+  std::vector<Pair> pairs_;
   Points wrapped_, sorted_;
 };
 
