@@ -13,34 +13,16 @@
 #include "bendlab/flow/lbm/section_walls.hpp"
 #include "bendlab/geometry/measures.hpp"
 #include "bendlab/geometry/point_in_mesh.hpp"
-#include "bendlab/membrane/espresso_volume_force.hpp"
-#include "bendlab/mesh/generators.hpp"
-#include "bendlab/surfaces/analytic_surface.hpp"
+#include "lbm/suspension_cells.hpp"
 
 using namespace bendlab;
 using namespace bendlab::lbm;
 
 namespace {
 
-// A red blood cell of eq. (15) with a large half-axis of R dx, 320 triangles, stress-free as it
-// is, neo-Hookean with modulus kS, no bending, ESPResSo's volume force. The explicit coupling is
-// stable while kS / (mu h) stays well below 1 (h the edge length, about 0.3 R; mu = 1/6 at tau = 1):
-// kS = 0.01 and below.
-std::shared_ptr<const MembraneModel> rbc(double R, double kS) {
-  const TriMesh s = sphere_mesh(MeshFamily::MT1, 2);
-  const TriMesh m = s.with_positions(make_rbc(R)->map_from_unit_sphere(s.positions()));
-  MembraneParameters p;
-  p.kS = kS;
-  p.volume_force = std::make_shared<const EspressoVolumeForce>(EspressoVolumeForce::for_membrane(kS));
-  return std::make_shared<const MembraneModel>(m, p);
-}
+using test::moved;
 
-Points moved(const Points& x, const Vec3& by, double turn_about_y = 0) {
-  const Mat3 R = Eigen::AngleAxisd(turn_about_y, Vec3::UnitY()).toRotationMatrix();
-  Points y = x * R.transpose();
-  y.rowwise() += by.transpose();
-  return y;
-}
+std::shared_ptr<const MembraneModel> rbc(double R, double kS) { return test::small_rbc(R, kS); }
 
 // Whether any vertex of cell a lies inside cell b (b at its nearest image to a along x).
 bool any_vertex_inside(const LbmSuspension& s, int a, int b) {

@@ -11,8 +11,7 @@
 
 namespace bendlab::lbm {
 
-namespace {
-SuspensionOptions checked(SuspensionOptions o) {
+SuspensionOptions checked_suspension_options(SuspensionOptions o) {
   o.cell_contact.validate();
   o.wall_contact.validate();
   if (!o.vertex_force.allFinite()) throw Error("suspension: the force per vertex is not finite");
@@ -22,22 +21,25 @@ SuspensionOptions checked(SuspensionOptions o) {
   }
   return o;
 }
-}  // namespace
 
-LbmSuspension::LbmSuspension(SuspensionOptions options) : options_(checked(std::move(options))), lattice_(options_.lattice) {}
+LbmSuspension::LbmSuspension(SuspensionOptions options) : options_(checked_suspension_options(std::move(options))), lattice_(options_.lattice) {}
 
-int LbmSuspension::add_cell(std::shared_ptr<const MembraneModel> membrane, const Points& X) {
+void append_cell_rows(const MembraneModel* membrane, const Points& X, Points& all) {
   if (!membrane) throw Error("suspension: no membrane model for the cell");
   if (X.rows() != membrane->num_vertices() || X.cols() != 3) {
     throw Error(fmt::format("suspension: {} positions for a membrane of {} vertices", X.rows(), membrane->num_vertices()));
   }
   if (!X.allFinite()) throw Error("suspension: a cell position is not finite");
+  Points grown(all.rows() + X.rows(), 3);
+  grown.topRows(all.rows()) = all;
+  grown.bottomRows(X.rows()) = X;
+  all = std::move(grown);
+}
+
+int LbmSuspension::add_cell(std::shared_ptr<const MembraneModel> membrane, const Points& X) {
   const int c = num_cells();
   const Eigen::Index first = X_.rows();
-  Points grown(first + X.rows(), 3);
-  grown.topRows(first) = X_;
-  grown.bottomRows(X.rows()) = X;
-  X_ = std::move(grown);
+  append_cell_rows(membrane.get(), X, X_);
   cells_.push_back(Cell{std::move(membrane), first});
   cell_of_.resize(X_.rows(), c);
   F_.setZero(X_.rows(), 3);

@@ -38,6 +38,13 @@ struct SuspensionOptions {
   Vec3 vertex_force = Vec3::Zero();  ///< an external force on every vertex (sedimentation, a push)
 };
 
+/// The options as LbmSuspension takes them; throws bendlab::Error for a bad lattice or contact
+/// law, or a vessel whose periods differ from the lattice's (shared with the MPI suspension).
+SuspensionOptions checked_suspension_options(SuspensionOptions options);
+/// Appends a cell's positions X to the rows of `all`; throws bendlab::Error (leaving `all` as it
+/// was) for a null model, a size mismatch or a non-finite position (shared with the MPI suspension).
+void append_cell_rows(const MembraneModel* membrane, const Points& X, Points& all);
+
 class LbmSuspension {
  public:
   /// Throws bendlab::Error for a bad lattice or contact law, or a vessel whose periods differ
