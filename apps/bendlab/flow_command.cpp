@@ -13,6 +13,10 @@
 #include "command.hpp"
 #include "method_cli.hpp"
 
+#ifdef BENDLAB_HAVE_MPI
+#include "bendlab/parallel/mpi_suspension_solver.hpp"
+#endif
+
 namespace bendlab::cli {
 namespace {
 
@@ -59,9 +63,24 @@ void flow(FlowArgs& a) {
   s.cell.method_options = a.options;
   if (!(a.t_end > 0) || !std::isfinite(a.t_end)) throw Error(fmt::format("--t-end {} s must be positive", a.t_end));
 
-  FlowRun run(s, note);
+  // Under mpirun: the fluid in y-slabs and each cell owned by one rank; rank 0 writes the run
+  // folder (docs/mpi.md, "Many cells").
+  const ProcessWorld& world = process_world();
+  SuspensionSolverFactory make_solver;
+  if (world.size > 1) {
+#ifdef BENDLAB_HAVE_MPI
+    if (s.units.geometry == lbm::FlowGeometry::Shear)
+      throw Error(fmt::format("{} processes: --geometry shear runs on one process (start it without mpirun); tubes and "
+                              "channels run in parallel", world.size));
+    make_solver = [](const SuspensionSolverOptions& o) {
+      return std::make_unique<parallel::MpiSuspensionSolver>(o, MPI_COMM_WORLD);
+    };
+    note(fmt::format("lattice Boltzmann fluid in y-slabs over {} MPI ranks, each cell owned by one", world.size));
+#endif
+  }
+  FlowRun run(s, note, make_solver);
   for (const std::string& line : run.describe()) note(line);
-  if (const auto w = run.warning()) note("warning: " + *w);
+  if (const auto w = run.warning()) note(*w);  // the warning names itself
   CapsuleRunOptions o;
   o.folder = a.out;
   o.t_end = a.t_end;
@@ -70,8 +89,9 @@ void flow(FlowArgs& a) {
   o.overwrite = a.overwrite;
   o.stop_after_steps = a.stop_after_steps;
   o.on_note = note;
+  o.writes_files = world.rank == 0;
   const double dt = run.units().dt;
-  const double nodes = static_cast<double>(run.solver().suspension().lattice().num_fluid_nodes());
+  const double nodes = run.fluid_nodes();
   o.on_progress = [dt, nodes](const CapsuleProgress& p) {
     std::string measures;
     for (const auto& [name, value] : p.measures) measures += fmt::format("  {} {:.4g}", name, value);
@@ -81,6 +101,7 @@ void flow(FlowArgs& a) {
                      p.elapsed_seconds > 0 ? steps * nodes / p.elapsed_seconds * 1e-6 : 0.0));
   };
   const CapsuleRunResult result = run.run(o);
+  if (world.rank != 0) return;
   if (!result.finished) {
     note(fmt::format("stopped after {} reports; continue with --resume", a.stop_after_steps));
     return;

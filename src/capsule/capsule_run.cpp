@@ -231,10 +231,8 @@ class Run {
   void write_checkpoint(const Points& x, double t) {
     const std::string tag = fmt::format("{:05d}", state_.snapshots.size());
     const std::string name = fmt::format("snapshot_{}.vtp", tag);
-    if (o_.writes_files) {
-      write_bodies_snapshot(o_.folder / name, solver_.bodies(), x);
-      recorder_.snapshot(o_.folder, tag);
-    }
+    if (o_.writes_files) write_bodies_snapshot(o_.folder / name, solver_.bodies(), x);
+    recorder_.snapshot(o_.folder, tag);  // on every process: its reads of the solver may be collective
     state_.snapshots.emplace_back(t, name);
     if (o_.writes_files) write_pvd(o_.folder / "shapes.pvd", state_.snapshots);
     const std::vector<std::string> old_side_files = state_.solver_state.side_files;

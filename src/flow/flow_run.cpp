@@ -67,7 +67,8 @@ Vessel vessel_of(const lbm::FlowUnitsInput& u, double scale) {
 
 }  // namespace
 
-FlowRun::FlowRun(const FlowRunSpec& spec, const std::function<void(const std::string&)>& note)
+FlowRun::FlowRun(const FlowRunSpec& spec, const std::function<void(const std::string&)>& note,
+                 const SuspensionSolverFactory& make_solver)
     : spec_(checked(spec)), units_(lbm::flow_units(spec_.units)), kind_(make_cell_kind(spec_.cell)) {
   auto say = [&](const std::string& s) {
     if (note) note(s);
@@ -131,14 +132,17 @@ FlowRun::FlowRun(const FlowRunSpec& spec, const std::function<void(const std::st
   o.dx_um = dx;
   o.dt_seconds = units_.dt;
   o.sample_every = spec_.sample_every;
-  solver_ = std::make_unique<LbmSuspensionSolver>(o);
+  solver_ = make_solver ? make_solver(o) : std::make_unique<LbmSuspensionSolver>(o);
 
-  lbm::Lattice& lattice = solver_->suspension().lattice();
+  // The cell-free flow on one whole lattice (on every process of a parallel run alike), handed to
+  // the solver once it is set.
+  lbm::Lattice lattice(o.suspension.lattice);
   if (shear) {
     // The walls' linear shear flow with its stress is a steady state of the lattice: no
     // relaxation, and no reference flow rate (the recorder reads the walls' stress instead).
     lattice.initialise_shear_flow();
     say(fmt::format("cell-free flow: the linear shear flow of the walls, {:.4g} 1/s", units_.pseudo_shear_rate));
+    solver_->set_fluid(std::move(lattice));
     add_cells();
     return;
   }
@@ -181,7 +185,16 @@ FlowRun::FlowRun(const FlowRunSpec& spec, const std::function<void(const std::st
   // The run starts at step 0 from the relaxed flow (the relaxation took a multiple of 100 steps,
   // so the populations are in the AA layout of an even step, as at step 0).
   lattice.restore_raw(lattice.raw_populations(), 0);
+  solver_->set_fluid(std::move(lattice));
   add_cells();
+}
+
+double FlowRun::fluid_nodes() const {
+  const lbm::LatticeConfig& c = solver_->options().suspension.lattice;
+  double rows = 0;
+  for (int k = 0; k < c.nz; ++k)
+    for (int j = 0; j < c.ny; ++j) rows += solver_->solid_line(j, k) ? 0 : 1;
+  return rows * c.nx;
 }
 
 void FlowRun::add_cells() {

@@ -10,7 +10,7 @@
 #include "bendlab/capsule/capsule_shape.hpp"
 #include "bendlab/capsule/checkpoint.hpp"
 #include "bendlab/core/atomic_file.hpp"
-#include "bendlab/flow/lbm/wall_stress.hpp"
+#include "bendlab/flow/lbm/diagnostics.hpp"
 #include "bendlab/suspension/flow_measures.hpp"
 
 namespace fs = std::filesystem;
@@ -45,28 +45,13 @@ std::vector<double> json_numbers(const nlohmann::json& j, std::size_t n, const s
   return v;
 }
 
-// Visits every line of fluid nodes along x, (j, k) in index order, with the sum of u_x along it;
-// returns the sum over all lines. The flow rate and the velocity profile share it, so that Q0 of
-// the cell-free flow and Q of a run without cells are summed alike, bit for bit.
-template <class Visit>
-double sum_lines(const lbm::Lattice& lattice, Visit&& visit) {
-  double flux = 0;
-  const int nx = lattice.nx();
-  for (int k = 0; k < lattice.nz(); ++k)
-    for (int j = 0; j < lattice.ny(); ++j) {
-      if (lattice.solid_row(j, k)) continue;
-      double line = 0;
-      for (int i = 0; i < nx; ++i) line += lattice.velocity(lattice.index(i, j, k)).x();
-      flux += line;
-      visit(j, k, line);
-    }
-  return flux;
-}
-
 }  // namespace
 
 double lattice_flow_rate(const lbm::Lattice& lattice, double dx_um, double dt_seconds) {
-  const double flux = sum_lines(lattice, [](int, int, double) {});
+  // The lines in index order, as the recorder adds them: Q0 and Q of a run without cells are
+  // summed alike, bit for bit.
+  double flux = 0;
+  for (double line : lbm::line_velocity_sums(lattice)) flux += line;
   return flux / lattice.nx() * dx_um * dx_um * dx_um / dt_seconds;
 }
 
@@ -107,8 +92,8 @@ const char* SuspensionRecorder::series_header() {
 
 const char* SuspensionRecorder::cells_header() { return "t_s,cell,x_um,y_um,z_um,u_um_s,D,axis_angle_deg"; }
 
-SuspensionRecorder::SuspensionRecorder(const LbmSuspensionSolver& solver, SuspensionRecorderOptions options)
-    : solver_(solver), options_(std::move(options)), shear_box_(solver.suspension().lattice().shear_rate() > 0) {
+SuspensionRecorder::SuspensionRecorder(const SuspensionSolver& solver, SuspensionRecorderOptions options)
+    : solver_(solver), options_(std::move(options)), shear_box_(solver.shear_rate() > 0) {
   if (!shear_box_ && (!(options_.reference_flow_rate > 0) || !std::isfinite(options_.reference_flow_rate)))
     throw Error(fmt::format("suspension recorder: the cell-free flow rate {} must be positive",
                             options_.reference_flow_rate));
@@ -117,19 +102,21 @@ SuspensionRecorder::SuspensionRecorder(const LbmSuspensionSolver& solver, Suspen
   if (!(options_.steady_from >= 0 && options_.steady_from < 1))
     throw Error(fmt::format("suspension recorder: the steady window's start {} must lie in [0, 1)", options_.steady_from));
   // Bins across the section, one dx wide, for the lines of lattice nodes along x.
-  const lbm::Lattice& lattice = solver_.suspension().lattice();
+  const lbm::LatticeConfig& lattice = solver_.options().suspension.lattice;
   const double dx = solver_.options().dx_um;
   const Vessel& v = options_.vessel_um;
-  bin_of_line_.assign(static_cast<std::size_t>(lattice.ny()) * lattice.nz(), -1);
+  bin_of_line_.assign(static_cast<std::size_t>(lattice.ny) * lattice.nz, -1);
+  fluid_line_.assign(bin_of_line_.size(), 0);
   int bins = 0;
-  for (int k = 0; k < lattice.nz(); ++k)
-    for (int j = 0; j < lattice.ny(); ++j) {
-      if (lattice.solid_row(j, k)) continue;
-      const Vec3 p = lattice.position(0, j, k) * dx;
+  for (int k = 0; k < lattice.nz; ++k)
+    for (int j = 0; j < lattice.ny; ++j) {
+      if (solver_.solid_line(j, k)) continue;
+      fluid_line_[static_cast<std::size_t>(j) + static_cast<std::size_t>(lattice.ny) * k] = 1;
+      const Vec3 p = solver_.node_position(0, j, k) * dx;
       if (v.wall_distance(p) <= 0) continue;
       const double across = v.kind() == VesselKind::Tube ? std::hypot(p.y(), p.z()) : p.z() + 0.5 * v.height();
       const int bin = static_cast<int>(std::floor(across / dx));
-      bin_of_line_[static_cast<std::size_t>(j) + static_cast<std::size_t>(lattice.ny()) * k] = bin;
+      bin_of_line_[static_cast<std::size_t>(j) + static_cast<std::size_t>(lattice.ny) * k] = bin;
       bins = std::max(bins, bin + 1);
     }
   bin_lines_.assign(static_cast<std::size_t>(bins), 0.0);
@@ -145,31 +132,35 @@ bool SuspensionRecorder::is_output(const std::string& name) const {
 }
 
 void SuspensionRecorder::snapshot(const fs::path& folder, const std::string& tag) {
-  const lbm::Lattice& lattice = solver_.suspension().lattice();
+  const lbm::LatticeConfig& lattice = solver_.options().suspension.lattice;
   const double dx = solver_.options().dx_um, dt = solver_.options().dt_seconds;
-  const int j = lattice.ny() / 2;  // the node row nearest y = 0 (y = 1/2 dx for an even ny)
+  const int j = lattice.ny / 2;  // the node row nearest y = 0 (y = 1/2 dx for an even ny)
+  std::vector<Vec3> velocity;
+  std::vector<double> density;
+  solver_.layer_fields(j, velocity, density);  // on every process: it may be collective
+  if (!writes_files_) return;
   AtomicFile f(folder / fmt::format("fluid_{}.vtk", tag));
   std::ostream& out = f.stream();
-  const Vec3 origin = lattice.position(0, j, 0) * dx;
+  const Vec3 origin = solver_.node_position(0, j, 0) * dx;
+  const std::size_t nodes = static_cast<std::size_t>(lattice.nx) * lattice.nz;
   out << "# vtk DataFile Version 3.0\n"
       << fmt::format("bendlab fluid slice y = {:.6g} um at t = {:.9g} s\n", origin.y(), solver_.time())
       << "ASCII\nDATASET STRUCTURED_POINTS\n"
-      << fmt::format("DIMENSIONS {} 1 {}\nORIGIN {:.9g} {:.9g} {:.9g}\nSPACING {:.9g} {:.9g} {:.9g}\n", lattice.nx(),
-                     lattice.nz(), origin.x(), origin.y(), origin.z(), dx, dx, dx)
-      << fmt::format("POINT_DATA {}\nVECTORS velocity_um_s double\n", lattice.nx() * lattice.nz());
-  for (int k = 0; k < lattice.nz(); ++k)
-    for (int i = 0; i < lattice.nx(); ++i) {
-      const Vec3 u = lattice.velocity(lattice.index(i, j, k)) * (dx / dt);
-      out << fmt::format("{:.9g} {:.9g} {:.9g}\n", u.x(), u.y(), u.z());
-    }
+      << fmt::format("DIMENSIONS {} 1 {}\nORIGIN {:.9g} {:.9g} {:.9g}\nSPACING {:.9g} {:.9g} {:.9g}\n", lattice.nx,
+                     lattice.nz, origin.x(), origin.y(), origin.z(), dx, dx, dx)
+      << fmt::format("POINT_DATA {}\nVECTORS velocity_um_s double\n", nodes);
+  for (std::size_t n = 0; n < nodes; ++n) {
+    const Vec3 u = velocity[n] * (dx / dt);
+    out << fmt::format("{:.9g} {:.9g} {:.9g}\n", u.x(), u.y(), u.z());
+  }
   out << "SCALARS density_lattice double 1\nLOOKUP_TABLE default\n";
-  for (int k = 0; k < lattice.nz(); ++k)
-    for (int i = 0; i < lattice.nx(); ++i) out << fmt::format("{:.12g}\n", lattice.density(lattice.index(i, j, k)));
+  for (std::size_t n = 0; n < nodes; ++n) out << fmt::format("{:.12g}\n", density[n]);
   f.commit();
 }
 
 void SuspensionRecorder::start(const fs::path& folder, double t_end, bool writes_files) {
   t_end_ = t_end;
+  writes_files_ = writes_files;
   if (!writes_files) return;
   series_.emplace(RowFile::create(folder / kSeries, series_header()));
   cells_.emplace(RowFile::create(folder / kCells, cells_header()));
@@ -185,7 +176,7 @@ double SuspensionRecorder::check_resume(const fs::path& folder, const CapsuleChe
     if (!rows.empty() && std::abs(rows.back()[0] - saved.time) > 1e-9 * std::max(1.0, std::abs(saved.time)))
       throw Error(fmt::format("{}: \"time\" is {} and \"steps\" {}, but row {} of '{}' is at t = {} s", source,
                               saved.time, saved.steps, rows.size(), (folder / kSeries).string(), rows.back()[0]));
-    RowFile::read_head(folder / kCells, cells_header(), saved.steps * solver_.suspension().num_cells());
+    RowFile::read_head(folder / kCells, cells_header(), saved.steps * num_cells());
   }
   const auto& r = saved.recorder;
   if (!r.contains("profiles") || !r.at("profiles").is_object())
@@ -205,6 +196,7 @@ void SuspensionRecorder::resume(const fs::path& folder, const CapsuleCheckpoint&
                                 bool writes_files, const std::function<void(const std::string&)>& note) {
   if (!saved_profiles_) throw Error("suspension recorder: resume without check_resume");
   t_end_ = t_end;
+  writes_files_ = writes_files;
   const nlohmann::json& p = *saved_profiles_;
   velocity_sum_ = json_numbers(p.at("velocity_sum"), bin_lines_.size(), "velocity_sum");
   hematocrit_sum_ = json_numbers(p.at("hematocrit_sum"), bin_lines_.size(), "hematocrit_sum");
@@ -217,38 +209,45 @@ void SuspensionRecorder::resume(const fs::path& folder, const CapsuleCheckpoint&
          "taken from timeseries.csv over the new one");
   if (!writes_files) return;
   series_.emplace(RowFile::resume(folder / kSeries, series_header(), saved.steps));
-  cells_.emplace(RowFile::resume(folder / kCells, cells_header(), saved.steps * solver_.suspension().num_cells()));
+  cells_.emplace(RowFile::resume(folder / kCells, cells_header(), saved.steps * num_cells()));
 }
 
+int SuspensionRecorder::num_cells() const { return static_cast<int>(solver_.bodies().size()); }
+
 void SuspensionRecorder::record(const AcceptedStep& s) {
-  const lbm::LbmSuspension& susp = solver_.suspension();
-  const lbm::Lattice& lattice = susp.lattice();
+  const lbm::LatticeConfig& lattice = solver_.options().suspension.lattice;
   const double dx = solver_.options().dx_um, dt = solver_.options().dt_seconds;
   const Points& x = *s.positions;
   const bool in_window = s.time >= options_.steady_from * t_end_ - 1e-12;
 
-  // The flow rate, and the velocity profile in the window.
-  const int nx = lattice.nx();
-  const double flux = sum_lines(lattice, [&](int j, int k, double line) {
-    const int bin = bin_of_line_[static_cast<std::size_t>(j) + static_cast<std::size_t>(lattice.ny()) * k];
-    if (in_window && bin >= 0) velocity_sum_[static_cast<std::size_t>(bin)] += line / nx * dx / dt;
-  });
+  // The flow rate, and the velocity profile in the window: the lines' sums added in index order
+  // (lattice_flow_rate's order, so that Q0 and Q of a run without cells are summed alike).
+  const int nx = lattice.nx;
+  const std::vector<double> lines = solver_.line_velocity_sums();
+  double flux = 0;
+  for (std::size_t line = 0; line < lines.size(); ++line) {
+    if (!fluid_line_[line]) continue;
+    flux += lines[line];
+    const int bin = bin_of_line_[line];
+    if (in_window && bin >= 0) velocity_sum_[static_cast<std::size_t>(bin)] += lines[line] / nx * dx / dt;
+  }
   const double Q = flux / nx * dx * dx * dx / dt;  // um^3/s, as lattice_flow_rate
   const Vessel& v = options_.vessel_um;
   const double area = v.volume() / v.length();
 
   // The cells.
   CellRows rows;
-  const int cells = susp.num_cells();
-  const Points U = susp.velocities() * (dx / dt);  // um/s
+  const std::vector<SolverBody> bodies = solver_.bodies();
+  const int cells = static_cast<int>(bodies.size());
+  const Points U = solver_.vertex_velocities() * (dx / dt);  // um/s
   for (int c = 0; c < cells; ++c) {
-    const Eigen::Index first = susp.first_row(c), count = susp.rows(c);
+    const Eigen::Index first = bodies[c].first_row, count = bodies[c].membrane->num_vertices();
     const Points xc = x.middleRows(first, count);
-    const CapsuleShape shape = capsule_shape(susp.membrane(c).topology(), xc);
+    const CapsuleShape shape = capsule_shape(bodies[c].membrane->topology(), xc);
     rows.first.push_back(first);
     rows.count.push_back(count);
     rows.volume.push_back(shape.volume);
-    rows.topology.push_back(&susp.membrane(c).topology());
+    rows.topology.push_back(&bodies[c].membrane->topology());
     if (cells_) {
       const double u = U.middleRows(first, count).col(0).mean();
       const double angle = std::acos(std::min(1.0, std::abs(shape.short_axis.x()))) * 180.0 / M_PI;
@@ -261,7 +260,7 @@ void SuspensionRecorder::record(const AcceptedStep& s) {
   // viscosity from the walls' stress instead of the flow rate.
   const double H_D = shear_box_ ? kNaN : cells ? discharge_hematocrit(v, rows, U, Q) : 0.0;
   const double cfl = cells ? cell_free_layer(v, x, options_.slice_width_um) : kNaN;
-  const double eta = shear_box_ ? lbm::wall_shear_stress(lattice) / (lattice.viscosity() * lattice.shear_rate())
+  const double eta = shear_box_ ? solver_.wall_shear_stress() / (solver_.viscosity() * solver_.shear_rate())
                                 : options_.reference_flow_rate / Q;
   last_ = {s.time, s.dt, Q, Q / area, eta, H_T, H_D, cfl};
   if (series_) series_->append(last_);
@@ -269,11 +268,11 @@ void SuspensionRecorder::record(const AcceptedStep& s) {
   if (in_window) {
     if (cells) {
       LineGrid grid;
-      grid.y0 = lattice.position(0, 0, 0).y() * dx;
-      grid.z0 = lattice.position(0, 0, 0).z() * dx;
+      grid.y0 = solver_.node_position(0, 0, 0).y() * dx;
+      grid.z0 = solver_.node_position(0, 0, 0).z() * dx;
       grid.dy = grid.dz = dx;
-      grid.ny = lattice.ny();
-      grid.nz = lattice.nz();
+      grid.ny = lattice.ny;
+      grid.nz = lattice.nz;
       const std::vector<double> occupancy = row_occupancy(v, rows, x, grid);
       for (std::size_t line = 0; line < occupancy.size(); ++line)
         if (bin_of_line_[line] >= 0) hematocrit_sum_[static_cast<std::size_t>(bin_of_line_[line])] += occupancy[line];
@@ -313,9 +312,9 @@ nlohmann::json SuspensionRecorder::summary(const fs::path& folder, double t_end,
   }
   fields["steady_window_s"] = {begin, t_end};
   fields["steady_rows"] = window_rows;
-  fields["cells"] = solver_.suspension().num_cells();
+  fields["cells"] = num_cells();
   if (shear_box_) {
-    fields["shear_rate_1_s"] = solver_.suspension().lattice().shear_rate() / solver_.options().dt_seconds;
+    fields["shear_rate_1_s"] = solver_.shear_rate() / solver_.options().dt_seconds;
   } else {
     fields["reference_flow_rate_um3_s"] = options_.reference_flow_rate;
   }

@@ -3,6 +3,8 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <memory>
 #include <string>
 
@@ -166,6 +168,36 @@ void DistributedLattice::restore_owned(const std::vector<double>& owned, std::in
       std::copy_n(src, layer, raw.data() + q * n + static_cast<std::size_t>(nx) * (1 + static_cast<std::size_t>(nl) * k));
   local_.restore_raw(raw, step);
   if (step % 2 == 1) exchange(true);
+}
+
+void DistributedLattice::check_blow_up() const {
+  // The first node in global index order with a non-finite or non-positive density, as
+  // lbm::find_blow_up reports it.
+  const lbm::LatticeConfig& g = global_;
+  const SlabDecomposition& s = slab_;
+  const lbm::Lattice& local = local_;
+  long long first = std::numeric_limits<long long>::max();
+  double rho_first = 0;
+  for (int k = 0; k < g.nz && first == std::numeric_limits<long long>::max(); ++k)
+    for (int j = s.begin; j < s.begin + s.count && first == std::numeric_limits<long long>::max(); ++j)
+      for (int i = 0; i < g.nx; ++i) {
+        const double rho = local.density(local_node(i, j, k));
+        if (!std::isfinite(rho) || !(rho > 0)) {
+          first = i + static_cast<long long>(g.nx) * (j + static_cast<long long>(g.ny) * k);
+          rho_first = rho;
+          break;
+        }
+      }
+  long long global_first = 0;
+  MPI_Allreduce(&first, &global_first, 1, MPI_LONG_LONG, MPI_MIN, comm_);
+  if (global_first == std::numeric_limits<long long>::max()) return;
+  const int i = static_cast<int>(global_first % g.nx);
+  const long long r = global_first / g.nx;
+  const int j = static_cast<int>(r % g.ny), k = static_cast<int>(r / g.ny);
+  MPI_Bcast(&rho_first, 1, MPI_DOUBLE, s.owner(j), comm_);
+  const Vec3 x = position(i, j, k);
+  throw Error(fmt::format("LBM blew up at step {}: density {} at node ({}, {}, {}) (position {:.3g}, {:.3g}, {:.3g})",
+                          step_count(), rho_first, i, j, k, x.x(), x.y(), x.z()));
 }
 
 double DistributedLattice::total_mass() const {

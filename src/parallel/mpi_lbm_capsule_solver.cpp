@@ -18,35 +18,7 @@ MpiLbmCapsuleSolver::MpiLbmCapsuleSolver(std::shared_ptr<const MembraneModel> me
   fluid_.initialise_shear_flow();
 }
 
-void MpiLbmCapsuleSolver::check_fluid() const {
-  // The first node in global index order with a non-finite or non-positive density, as
-  // lbm::find_blow_up reports it.
-  const lbm::LatticeConfig& g = fluid_.config();
-  const SlabDecomposition& s = fluid_.slab();
-  const lbm::Lattice& local = fluid_.local();
-  long long first = std::numeric_limits<long long>::max();
-  double rho_first = 0;
-  for (int k = 0; k < g.nz && first == std::numeric_limits<long long>::max(); ++k)
-    for (int j = s.begin; j < s.begin + s.count && first == std::numeric_limits<long long>::max(); ++j)
-      for (int i = 0; i < g.nx; ++i) {
-        const double rho = local.density(fluid_.local_node(i, j, k));
-        if (!std::isfinite(rho) || !(rho > 0)) {
-          first = i + static_cast<long long>(g.nx) * (j + static_cast<long long>(g.ny) * k);
-          rho_first = rho;
-          break;
-        }
-      }
-  long long global_first = 0;
-  MPI_Allreduce(&first, &global_first, 1, MPI_LONG_LONG, MPI_MIN, fluid_.comm());
-  if (global_first == std::numeric_limits<long long>::max()) return;
-  const int i = static_cast<int>(global_first % g.nx);
-  const long long r = global_first / g.nx;
-  const int j = static_cast<int>(r % g.ny), k = static_cast<int>(r / g.ny);
-  MPI_Bcast(&rho_first, 1, MPI_DOUBLE, s.owner(j), fluid_.comm());
-  const Vec3 x = fluid_.position(i, j, k);
-  throw Error(fmt::format("LBM blew up at step {}: density {} at node ({}, {}, {}) (position {:.3g}, {:.3g}, {:.3g})",
-                          fluid_.step_count(), rho_first, i, j, k, x.x(), x.y(), x.z()));
-}
+void MpiLbmCapsuleSolver::check_fluid() const { fluid_.check_blow_up(); }
 
 void MpiLbmCapsuleSolver::ib_step(Points& X, const Points& F, Points& U) {
   const lbm::LatticeConfig& g = fluid_.config();

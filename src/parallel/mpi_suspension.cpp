@@ -361,14 +361,14 @@ void MpiSuspension::wrap(int c) {
   }
 }
 
-Points MpiSuspension::gather_positions() const {
+Points MpiSuspension::gather_rows(const Points& M) const {
   // Each owner's cells: their indices, then their rows.
   const int ranks = fluid_.slab().ranks;
   MPI_Comm comm = fluid_.comm();
   std::vector<double> mine;
   for (int c : owned_) {
     mine.push_back(static_cast<double>(c));
-    for (Eigen::Index k = first_row(c); k < first_row(c) + rows(c); ++k) mine.insert(mine.end(), {X_(k, 0), X_(k, 1), X_(k, 2)});
+    for (Eigen::Index k = first_row(c); k < first_row(c) + rows(c); ++k) mine.insert(mine.end(), {M(k, 0), M(k, 1), M(k, 2)});
   }
   int count = static_cast<int>(mine.size());
   std::vector<int> counts(static_cast<std::size_t>(ranks)), displs(static_cast<std::size_t>(ranks) + 1, 0);
@@ -376,7 +376,7 @@ Points MpiSuspension::gather_positions() const {
   for (int r = 0; r < ranks; ++r) displs[r + 1] = displs[r] + counts[r];
   std::vector<double> all(static_cast<std::size_t>(displs[ranks]));
   MPI_Allgatherv(mine.data(), count, MPI_DOUBLE, all.data(), counts.data(), displs.data(), MPI_DOUBLE, comm);
-  Points X(X_.rows(), 3);
+  Points X(M.rows(), 3);
   for (std::size_t at = 0; at < all.size();) {
     const int c = static_cast<int>(all[at++]);
     for (Eigen::Index k = first_row(c); k < first_row(c) + rows(c); ++k, at += 3) X.row(k) << all[at], all[at + 1], all[at + 2];

@@ -1,9 +1,10 @@
 #!/usr/bin/python3
-"""`mpirun -np N bendlab shear --solver lbm` against the serial command (ctest parallel.cli):
-the same files in the run folder, the same time series and summary to the
-last digit, stdout's summary only once; a checkpoint of N ranks
-resumed by the serial command; an error on the ranks ends the run with status != 0 and a line
-naming the rank and the problem.
+"""`mpirun -np N bendlab shear --solver lbm` and `mpirun -np N bendlab flow` (a tube with two red
+blood cells) against the serial command (ctest parallel.cli): the same files in the run folder
+(for flow every file byte for byte: time series, per-cell rows, profiles, fluid slices and
+snapshots), the same time series and summary to the last digit, stdout's summary only once; a
+checkpoint of N ranks resumed by the serial command, and the serial one by N ranks; an error on
+the ranks ends the run with status != 0 and a line naming the rank and the problem.
 Usage: cli_mpi_check.py BENDLAB MPIEXEC N
 """
 import json
@@ -53,4 +54,43 @@ with tempfile.TemporaryDirectory() as d:
     assert "error: --out" in bad.stderr and "is a file, not a folder" in bad.stderr, bad.stderr
     assert bad.stderr.count("error: --out") == 1, bad.stderr
     assert "rank" not in bad.stderr.split("error: --out")[0].splitlines()[-1], bad.stderr
-print(f"cli_mpi_check: mpirun -n {ranks} bendlab shear --solver lbm matches the serial command")
+
+# Many cells: each rank owns whole cells (docs/mpi.md, "Many cells").
+FLOW = ["flow", "--geometry", "tube", "--diameter", "9", "--length", "12", "--dx", "0.5", "--tau", "1",
+        "--pseudo-shear-rate", "100", "--cells", "2", "--mesh", "mt1:320", "--t-end", "2e-4", "--sample-every", "2e-5",
+        "--snapshot-every", "1e-4"]
+
+
+def same_files(a, b, what, but=("timing.json",)):
+    names = sorted(os.listdir(a))
+    assert names == sorted(os.listdir(b)), (what, names, sorted(os.listdir(b)))
+    for n in names:
+        if n == "checkpoint.json":  # all but its clock
+            ca, cb = json.loads((a / n).read_text()), json.loads((b / n).read_text())
+            ca.pop("wall_seconds"), cb.pop("wall_seconds")
+            assert ca == cb, f"{what}: {n} differs"
+        elif n not in but and not n.endswith(".lock"):
+            assert (a / n).read_bytes() == (b / n).read_bytes(), f"{what}: {n} differs"
+
+
+with tempfile.TemporaryDirectory() as d:
+    d = pathlib.Path(d)
+    serial = run([bendlab] + FLOW + ["--out", str(d / "serial")])
+    par = run(MPI + [bendlab] + FLOW + ["--out", str(d / "par")])
+    same_series(d / "serial", d / "par", "flow, mpirun")
+    same_files(d / "serial", d / "par", "flow, mpirun")
+    assert len(par.stdout.strip().splitlines()) == 1, f"summary printed {len(par.stdout.splitlines())} times"
+    # Interrupted on N ranks and resumed by the serial program, and the other way round.
+    run(MPI + [bendlab] + FLOW + ["--out", str(d / "resumed"), "--stop-after-steps", "4"])
+    run([bendlab] + FLOW + ["--out", str(d / "resumed"), "--resume"])
+    same_series(d / "serial", d / "resumed", "flow, resumed by the serial command")
+    run([bendlab] + FLOW + ["--out", str(d / "resumed2"), "--stop-after-steps", "4"])
+    run(MPI + [bendlab] + FLOW + ["--out", str(d / "resumed2"), "--resume"])
+    same_series(d / "serial", d / "resumed2", "flow, resumed on N ranks")
+    # The shear box stays on one process: refused on every rank with one line.
+    bad = run(MPI + [bendlab, "flow", "--geometry", "shear", "--height", "10", "--width", "10", "--length", "10",
+                     "--shear-rate", "100", "--cells", "1", "--out", str(d / "shear")], check=False)
+    if int(ranks) > 1:
+        assert bad.returncode != 0 and bad.stderr.count("--geometry shear runs on one process") == 1, bad.stderr
+        assert not (d / "shear").exists(), "a refused run must not write its folder"
+print(f"cli_mpi_check: mpirun -n {ranks} bendlab shear --solver lbm and bendlab flow match the serial command")

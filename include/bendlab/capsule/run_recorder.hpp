@@ -56,8 +56,10 @@ class RunRecorder {
 
   /// Records an accepted step (appending to the files when writing them).
   virtual void record(const AcceptedStep& step) = 0;
-  /// Called with each snapshot of the bodies (snapshot_<tag>.vtp), before its checkpoint, when
-  /// the run writes files: a recorder may write files of its own for it (a fluid slice).
+  /// Called with each snapshot of the bodies (snapshot_<tag>.vtp), before its checkpoint, on
+  /// every process of the run: a recorder may write files of its own for it (a fluid slice) where
+  /// the run writes files (the flag start() and resume() received), and its reads of a parallel
+  /// solver are collective.
   virtual void snapshot(const std::filesystem::path& folder, const std::string& tag) {
     (void)folder;
     (void)tag;

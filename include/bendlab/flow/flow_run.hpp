@@ -35,6 +35,8 @@
 
 namespace bendlab {
 
+using SuspensionSolverFactory = std::function<std::unique_ptr<SuspensionSolver>(const SuspensionSolverOptions&)>;
+
 struct FlowRunSpec {
   lbm::FlowUnitsInput units;           ///< geometry, sizes (um), dx, tau, plasma, driving
   CellKindSpec cell;                   ///< the cells' kind and membrane (physical units)
@@ -60,7 +62,10 @@ class FlowRun {
   /// Validates (throws bendlab::Error naming the option: the units' refusals, a bad cell kind, a
   /// negative or unplaceable hematocrit with the best reached, a vessel narrower than a cell),
   /// places the cells and relaxes the cell-free flow. `note` receives progress lines.
-  FlowRun(const FlowRunSpec& spec, const std::function<void(const std::string&)>& note = nullptr);
+  /// `make_solver` makes the solver from its options (default: LbmSuspensionSolver, one
+  /// process; `mpirun bendlab flow` passes parallel::MpiSuspensionSolver's).
+  FlowRun(const FlowRunSpec& spec, const std::function<void(const std::string&)>& note = nullptr,
+          const SuspensionSolverFactory& make_solver = nullptr);
 
   const FlowRunSpec& spec() const { return spec_; }
   const lbm::FlowUnits& units() const { return units_; }
@@ -75,7 +80,9 @@ class FlowRun {
   /// The mesh leak warning of the kind at this dx (cell_kind.hpp), if any.
   std::optional<std::string> warning() const;
 
-  LbmSuspensionSolver& solver() { return *solver_; }
+  SuspensionSolver& solver() { return *solver_; }
+  /// The lattice's fluid nodes (for MLUPS).
+  double fluid_nodes() const;
   /// The run (capsule_run.hpp's options, t_end and snapshot_every in seconds); its arguments are
   /// spec().to_json() merged with options.arguments.
   CapsuleRunResult run(CapsuleRunOptions options);
@@ -91,7 +98,7 @@ class FlowRun {
   Placement placement_;
   double q0_ = 0;
   std::int64_t relax_steps_ = 0;
-  std::unique_ptr<LbmSuspensionSolver> solver_;
+  std::unique_ptr<SuspensionSolver> solver_;
 };
 
 }  // namespace bendlab

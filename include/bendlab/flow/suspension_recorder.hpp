@@ -39,7 +39,8 @@
 
 #include "bendlab/capsule/run_recorder.hpp"
 #include "bendlab/core/row_file.hpp"
-#include "bendlab/flow/lbm/lbm_suspension_solver.hpp"
+#include "bendlab/flow/lbm/lattice.hpp"
+#include "bendlab/flow/suspension_solver.hpp"
 #include "bendlab/suspension/vessel.hpp"
 
 namespace bendlab {
@@ -51,8 +52,8 @@ struct SuspensionRecorderOptions {
   double steady_from = 0.5;                 ///< the steady window starts at steady_from t_end
 };
 
-/// Q of a lattice in um^3/s: the fluid nodes' u_x summed and divided by the period, as the
-/// recorder's flow rate.
+/// Q of a lattice in um^3/s: the lines' sums added in index order and divided by the period, as
+/// the recorder's flow rate.
 double lattice_flow_rate(const lbm::Lattice& lattice, double dx_um, double dt_seconds);
 
 /// Mean and standard error of `values` (batch means as above); NaN for no values.
@@ -67,7 +68,7 @@ class SuspensionRecorder final : public RunRecorder {
   /// Keeps `solver` by reference. Throws bendlab::Error for a non-positive Q0 (outside the shear
   /// box), slice width or a
   /// steady_from outside [0, 1).
-  SuspensionRecorder(const LbmSuspensionSolver& solver, SuspensionRecorderOptions options);
+  SuspensionRecorder(const SuspensionSolver& solver, SuspensionRecorderOptions options);
 
   bool is_output(const std::string& name) const override;
   void start(const std::filesystem::path& folder, double t_end, bool writes_files) override;
@@ -76,7 +77,7 @@ class SuspensionRecorder final : public RunRecorder {
   void resume(const std::filesystem::path& folder, const CapsuleCheckpoint& saved, double t_end, bool writes_files,
               const std::function<void(const std::string&)>& note) override;
   void record(const AcceptedStep& step) override;
-  /// fluid_<tag>.vtk.
+  /// fluid_<tag>.vtk (the layer is read on every process: the solver's read may be collective).
   void snapshot(const std::filesystem::path& folder, const std::string& tag) override;
   /// H_D, eta_app / eta and the cell-free layer of the last row.
   ProgressMeasures progress() const override;
@@ -89,7 +90,10 @@ class SuspensionRecorder final : public RunRecorder {
   static const char* cells_header();
 
  private:
-  const LbmSuspensionSolver& solver_;
+  int num_cells() const;
+
+  const SuspensionSolver& solver_;
+  bool writes_files_ = false;
   SuspensionRecorderOptions options_;
   bool shear_box_ = false;  // the lattice's walls move: viscosity from their stress
   double t_end_ = 0;
@@ -98,6 +102,7 @@ class SuspensionRecorder final : public RunRecorder {
   // The profiles: per bin, its lines of fluid nodes along x, and the running sums over the
   // window's samples.
   std::vector<int> bin_of_line_;  // per (j, k) line of the lattice; -1 outside the fluid
+  std::vector<char> fluid_line_;  // per (j, k) line: not in the wall's solid rows
   std::vector<double> bin_lines_, velocity_sum_, hematocrit_sum_;
   std::int64_t profile_samples_ = 0;
   std::optional<nlohmann::json> saved_profiles_;

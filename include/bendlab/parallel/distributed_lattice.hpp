@@ -68,6 +68,10 @@ class DistributedLattice {
   /// Wall seconds spent in the halo exchange so far (packing, MPI, unpacking; for benchmarks).
   double halo_seconds() const { return halo_seconds_; }
 
+  /// Throws bendlab::Error on every rank, naming the node and step as lbm::find_blow_up does, if
+  /// any owned node has a non-finite or non-positive density (collective).
+  void check_blow_up() const;
+
   /// Sum over all ranks of rho and of sum f c (without F/2) over the owned fluid nodes (collective;
   /// the order of the sum differs from Lattice's).
   double total_mass() const;

@@ -64,7 +64,9 @@ class MpiSuspension {
 
   /// Every vertex, cell after cell, as LbmSuspension::positions() (collective: each owner's
   /// cells gathered onto every rank).
-  Points gather_positions() const;
+  Points gather_positions() const { return gather_rows(X_); }
+  /// The vertex velocities of the last step, as LbmSuspension::velocities() (collective).
+  Points gather_velocities() const { return gather_rows(U_); }
   /// Replaces every vertex by X (lattice units, the rows of gather_positions(); the same on every
   /// rank); the fluid is restored through fluid(). Throws bendlab::Error for a size mismatch.
   void restore(const Points& X);
@@ -91,6 +93,8 @@ class MpiSuspension {
   // if it is one of them).
   std::vector<int> reach(int c) const;
   double centroid_y(int c) const;
+  // The rows of M of every cell, from its owner, on every rank (collective).
+  Points gather_rows(const Points& M) const;
   int owner_of_layer_at(double y) const;
   // The largest |y - centroid y| over the vertices of the cells in `cells`.
   double extent_y(const std::vector<int>& cells) const;

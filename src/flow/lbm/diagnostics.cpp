@@ -27,4 +27,16 @@ std::optional<BlowUp> find_blow_up(const Lattice& lattice) {
   return b;
 }
 
+std::vector<double> line_velocity_sums(const Lattice& lattice) {
+  std::vector<double> lines(static_cast<std::size_t>(lattice.ny()) * lattice.nz(), 0.0);
+  for (int k = 0; k < lattice.nz(); ++k)
+    for (int j = 0; j < lattice.ny(); ++j) {
+      if (lattice.solid_row(j, k)) continue;
+      double line = 0;
+      for (int i = 0; i < lattice.nx(); ++i) line += lattice.velocity(lattice.index(i, j, k)).x();
+      lines[static_cast<std::size_t>(j) + static_cast<std::size_t>(lattice.ny()) * k] = line;
+    }
+  return lines;
+}
+
 }  // namespace bendlab::lbm

@@ -1,121 +1,45 @@
 #include "bendlab/flow/lbm/lbm_suspension_solver.hpp"
 
-#include <fmt/format.h>
-
-#include <algorithm>
-#include <cmath>
-
 #include "bendlab/flow/lbm/checkpoint.hpp"
 #include "bendlab/flow/lbm/diagnostics.hpp"
-#include "bendlab/flow/lbm/fluid_state.hpp"
+#include "bendlab/flow/lbm/wall_stress.hpp"
 
 namespace bendlab {
 
-namespace {
-const SuspensionSolverOptions& checked(const SuspensionSolverOptions& o) {
-  for (const auto& [name, value] : {std::pair<const char*, double>{"dx", o.dx_um}, {"dt", o.dt_seconds},
-                                    {"sample_every", o.sample_every}})
-    if (!(value > 0) || !std::isfinite(value))
-      throw Error(fmt::format("suspension solver: {} must be positive and finite, got {}", name, value));
-  return o;
-}
-}  // namespace
-
 LbmSuspensionSolver::LbmSuspensionSolver(SuspensionSolverOptions options)
-    : options_(checked(options)),
-      suspension_(options_.suspension),
-      sample_steps_(std::max<std::int64_t>(1, std::llround(options_.sample_every / options_.dt_seconds))) {}
+    : SuspensionSolver(options), suspension_(options.suspension) {}
 
-const MembraneModel& LbmSuspensionSolver::membrane() const {
-  if (suspension_.num_cells() == 0) throw Error("suspension solver: no cells");
-  return suspension_.membrane(0);
+void LbmSuspensionSolver::set_fluid(lbm::Lattice whole) { suspension_.restore(std::move(whole), suspension_.positions()); }
+
+std::vector<double> LbmSuspensionSolver::line_velocity_sums() const { return lbm::line_velocity_sums(suspension_.lattice()); }
+
+void LbmSuspensionSolver::layer_fields(int j, std::vector<Vec3>& velocity, std::vector<double>& density) const {
+  const lbm::Lattice& lattice = suspension_.lattice();
+  velocity.clear();
+  density.clear();
+  for (int k = 0; k < lattice.nz(); ++k)
+    for (int i = 0; i < lattice.nx(); ++i) {
+      velocity.push_back(lattice.velocity(lattice.index(i, j, k)));
+      density.push_back(lattice.density(lattice.index(i, j, k)));
+    }
 }
 
-std::vector<SolverBody> LbmSuspensionSolver::bodies() const {
-  std::vector<SolverBody> b;
-  b.reserve(static_cast<std::size_t>(suspension_.num_cells()));
-  for (int c = 0; c < suspension_.num_cells(); ++c) b.push_back({&suspension_.membrane(c), suspension_.first_row(c)});
-  return b;
-}
-
-int LbmSuspensionSolver::add_cell(std::shared_ptr<const MembraneModel> lattice_membrane, const Points& X_um) {
-  const int c = suspension_.add_cell(std::move(lattice_membrane), X_um / options_.dx_um);
-  sync_positions();
-  return c;
-}
-
-void LbmSuspensionSolver::sync_positions() { x_ = suspension_.positions() * options_.dx_um; }
+double LbmSuspensionSolver::wall_shear_stress() const { return lbm::wall_shear_stress(suspension_.lattice()); }
 
 void LbmSuspensionSolver::check_fluid() const {
   if (const auto b = lbm::find_blow_up(suspension_.lattice())) throw Error(b->message);
 }
 
-bool LbmSuspensionSolver::advance(double t_end, const OnStep& on_step) {
-  // Whole lattice steps: the run ends at the first step at or beyond t_end.
-  const auto end_step = static_cast<std::int64_t>(std::ceil(t_end / options_.dt_seconds - 1e-9));
-  std::int64_t last_report = suspension_.steps();
-  while (suspension_.steps() < end_step) {
-    suspension_.step();
-    const std::int64_t n = suspension_.steps();
-    ++counters_.velocity_evaluations;
-    if (n - last_fluid_check_ >= kFluidCheckSteps) {
-      check_fluid();
-      last_fluid_check_ = n;
-    }
-    if (n % sample_steps_ != 0 && n < end_step) continue;
-    sync_positions();
-    if (!on_step) {
-      last_report = n;
-      continue;
-    }
-    AcceptedStep s;
-    s.time = time();
-    // The run's end test compares times: the last step reports t_end itself when it lands there.
-    if (n == end_step) s.time = std::max(s.time, t_end);
-    s.dt = static_cast<double>(n - last_report) * options_.dt_seconds;
-    s.positions = &x_;
-    last_report = n;
-    if (!on_step(s)) return false;
-  }
-  return true;
+void LbmSuspensionSolver::write_fluid(const std::filesystem::path& file) const {
+  lbm::write_checkpoint(suspension_.lattice(), file);
 }
 
-bool LbmSuspensionSolver::is_side_file(const std::string& name) const { return lbm::is_fluid_file(name); }
-
-SolverState LbmSuspensionSolver::save_state(const std::filesystem::path& folder, const std::string& tag) const {
-  check_fluid();  // never checkpoint a broken fluid
-  SolverState s;
-  const std::string fluid = lbm::fluid_file_name(tag);
-  lbm::write_checkpoint(suspension_.lattice(), folder / fluid);
-  s.side_files.push_back(fluid);
-  s.fields = lbm::fluid_state_fields(fluid, suspension_.steps(), suspension_.positions());
-  return s;
-}
-
-void LbmSuspensionSolver::restore_state(const Points& positions, double time, const SolverCounters& counters,
-                                        const nlohmann::json& fields, const std::filesystem::path& folder,
-                                        const std::string& source) {
-  auto bad = [&](const std::string& what) { return Error(fmt::format("{}: \"solver_state\": {}", source, what)); };
-  const lbm::FluidStateFields saved = lbm::parse_fluid_state(fields, suspension_.positions().rows(), source);
-  const double t = static_cast<double>(saved.lattice_step) * options_.dt_seconds;
-  if (std::abs(t - time) > 1e-9 * std::max(1.0, std::abs(time)) + options_.dt_seconds)
-    throw bad(fmt::format("\"lattice_step\" {} is t = {} s, the checkpoint's time is {} s", saved.lattice_step, t, time));
-  if (positions.rows() != saved.X.rows() ||
-      (saved.X * options_.dx_um - positions).cwiseAbs().maxCoeff() > 1e-9 * std::max(1.0, positions.cwiseAbs().maxCoeff()))
-    throw bad("\"positions_lattice\" do not match the checkpoint's positions");
+std::int64_t LbmSuspensionSolver::read_state(const std::filesystem::path& file, std::int64_t step, const Points& X) {
   lbm::Lattice restored(suspension_.lattice().config());
-  try {
-    lbm::read_checkpoint(restored, folder / saved.fluid);
-  } catch (const Error& e) {
-    throw Error(fmt::format("{}: {}", source, e.what()));
-  }
-  if (restored.step_count() != saved.lattice_step)
-    throw bad(fmt::format("the fluid file is at step {}, \"lattice_step\" is {}", restored.step_count(),
-                          saved.lattice_step));
-  suspension_.restore(std::move(restored), saved.X);
-  sync_positions();
-  counters_ = counters;
-  last_fluid_check_ = saved.lattice_step;
+  lbm::read_checkpoint(restored, file);
+  const std::int64_t file_step = restored.step_count();
+  if (file_step == step) suspension_.restore(std::move(restored), X);
+  return file_step;
 }
 
 }  // namespace bendlab

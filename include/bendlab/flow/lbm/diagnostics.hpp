@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "bendlab/flow/lbm/lattice.hpp"
 
@@ -21,5 +22,10 @@ struct BlowUp {
 
 /// The first node (in index order) whose density is not finite or not positive, or nothing.
 std::optional<BlowUp> find_blow_up(const Lattice& lattice);
+
+/// Per line of nodes along x, index j + ny k: u_x summed over i = 0 .. nx - 1 in that order
+/// (lattice units; 0 for a solid row). The flow rate and the velocity profiles of a suspension
+/// run add these (flow/suspension_recorder.hpp).
+std::vector<double> line_velocity_sums(const Lattice& lattice);
 
 }  // namespace bendlab::lbm
