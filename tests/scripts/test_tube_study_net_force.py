@@ -89,3 +89,14 @@ def test_failure_message(tmp_path):
     assert tube_study.failed_at(err) == pytest.approx(0.0110969)
     assert tube_study.failed_at("the run failed after step 3 (gamma t = 0.5): x") == pytest.approx(0.5)
     assert tube_study.failed_at("no time here") is None
+
+
+def test_pries_hematocrit_inverts_the_law():
+    # The hematocrit found gives back the viscosity it was asked for, at several diameters, and a
+    # viscosity beyond the law's range has none.
+    for D in (10.0, 15.0, 20.0):
+        for H in (0.1, 0.3, 0.45, 0.6):
+            eta = tube_study.pries_in_vitro(D, H)
+            h = tube_study.pries_hematocrit(D, eta)
+            assert h == pytest.approx(H, abs=1e-9)
+    assert tube_study.pries_hematocrit(10.0, 0.5) is None
