@@ -21,7 +21,7 @@ namespace bendlab::cli {
 namespace {
 
 struct FlowArgs {
-  std::string geometry = "tube", out;
+  std::string geometry = "tube", out, bending_net_force = "keep";
   std::optional<double> diameter, height, width, pseudo_shear_rate, body_force, shear_rate, hematocrit;
   std::optional<int> cells;
   double length = 0;
@@ -61,6 +61,7 @@ void flow(FlowArgs& a) {
     throw Error(fmt::format("--contact-force {} pN must be >= 0 (0: the default G_s dx)", a.contact_force_pn));
   s.contact_force = a.contact_force_pn * 1e-12;
   s.cell.method_options = a.options;
+  s.cell.bending_without_net_force = a.bending_net_force == "remove";
   if (!(a.t_end > 0) || !std::isfinite(a.t_end)) throw Error(fmt::format("--t-end {} s must be positive", a.t_end));
 
   // Under mpirun: the fluid in y-slabs and each cell owned by one rank; rank 0 writes the run
@@ -153,6 +154,10 @@ const CommandRegistration flow_registration([](CLI::App& app) {
   cmd->add_option("--method", s.cell.method, "bending method: " + method_names_joined())
       ->check(CLI::IsMember(method_choices_with_none()))->capture_default_str();
   cmd->add_option("--option", args->options, "method option key=value, repeatable (bendlab methods)");
+  cmd->add_option("--bending-net-force", args->bending_net_force,
+                  "keep: the bending method's force as it is; remove: take its net force and torque off each cell "
+                  "(momentum-conserving bending for Methods C, D, E, M, whose discrete force has them)")
+      ->check(CLI::IsMember({"keep", "remove"}))->capture_default_str();
   cmd->add_option("--membrane", s.cell.elastic_law, "in-plane elastic law: skalak or neo-hookean")
       ->check(CLI::IsMember({"skalak", "neo-hookean"}))->capture_default_str();
   cmd->add_option("--shear-modulus", s.cell.shear_modulus, "membrane shear modulus G_s, N/m")->capture_default_str();

@@ -28,7 +28,7 @@ MethodOptions parse_options(const std::vector<std::string>& options) {
 }  // namespace
 
 nlohmann::json CellKindSpec::to_json() const {
-  return {{"cell", shape},
+  nlohmann::json j = {{"cell", shape},
           {"cell_radius_um", radius_um},
           {"mesh", mesh},
           {"elastic_law", elastic_law},
@@ -38,6 +38,8 @@ nlohmann::json CellKindSpec::to_json() const {
           {"method", method},
           {"method_options", method_options},
           {"volume_modulus_ratio", volume_modulus_ratio}};
+  if (bending_without_net_force) j["bending_without_net_force"] = true;
+  return j;
 }
 
 void check_cell_kind(const CellKindSpec& s) {
@@ -54,6 +56,8 @@ void check_cell_kind(const CellKindSpec& s) {
           fmt::format("volume modulus ratio {} must be finite and not negative", s.volume_modulus_ratio));
   // The bending method and its options, before any work ("none": no bending force).
   if (s.method != "none") make_bending_method(s.method, parse_options(s.method_options));
+  require(!s.bending_without_net_force || (s.method != "none" && s.bending_modulus > 0),
+          "--bending-net-force remove needs a bending force (a --method other than none and --bending-modulus > 0)");
 }
 
 CellKind make_cell_kind(const CellKindSpec& spec) {
@@ -90,6 +94,7 @@ std::shared_ptr<const MembraneModel> lattice_membrane(const CellKind& kind, cons
   p.kS = units.to_lattice_modulus(3.0 * s.shear_modulus);  // k_S = 3 G_s
   p.kB = s.method == "none" ? 0.0 : units.to_lattice_energy(s.bending_modulus);
   if (p.kB > 0) p.bending = make_bending_method(s.method, parse_options(s.method_options));
+  p.bending_without_net_force = s.bending_without_net_force;
   if (s.volume_modulus_ratio > 0) {
     // kappa_V = ratio kS / R: the capsule runs' kappa_V = 100 kS in units of the cell's radius
     // (cell_kind.hpp), here in lattice units, R = radius / dx.
@@ -109,6 +114,7 @@ std::shared_ptr<const MembraneModel> physical_membrane(const CellKind& kind) {
   p.kS = 3.0 * s.shear_modulus * 1e6;  // k_S = 3 G_s; N/m -> pN/um
   p.kB = s.bending_modulus * 1e18;     // J -> pN um
   if (p.kB > 0) p.bending = make_bending_method(s.method, parse_options(s.method_options));
+  p.bending_without_net_force = s.bending_without_net_force;
   if (s.volume_modulus_ratio > 0)
     p.volume_force = std::make_shared<const EspressoVolumeForce>(s.volume_modulus_ratio * p.kS / s.radius_um);
   return std::make_shared<const MembraneModel>(kind.reference_um, std::move(p));

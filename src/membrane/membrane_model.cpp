@@ -7,6 +7,7 @@
 #include "bendlab/core/finite_check.hpp"
 #include "bendlab/geometry/measures.hpp"
 #include "bendlab/geometry/mesh_geometry.hpp"
+#include "bendlab/membrane/rigid_projection.hpp"
 
 namespace bendlab {
 
@@ -60,6 +61,7 @@ void MembraneModel::forces(const Points& x, Points& force) const {
     else
       parameters_.bending->forces(*topology_, x, parameters_.bending_parameters(), bending);
     require_finite_rows(bending, "membrane: the bending force of method " + parameters_.bending->name());
+    if (parameters_.bending_without_net_force) remove_rigid_motion(x, bending);
     force += bending;
   }
   if (parameters_.volume_force != nullptr) {

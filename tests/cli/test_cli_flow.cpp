@@ -62,6 +62,24 @@ TEST_F(Cli, FlowRefusesBadInputWithOneLineBeforeWork) {
                  "--width", out);
   expect_refused(run("flow --hematocrit 0 --diameter 10 --length 10 --out " + out.string()), "driving", out);
   expect_refused(run("flow --hematocrit 0 --method M --option degree=9" + tube), "degree", out);
+  expect_refused(run("flow --hematocrit 0 --method none --bending-net-force remove" + tube), "--bending-net-force", out);
+  expect_refused(run("flow --hematocrit 0 --bending-net-force drop" + tube), "--bending-net-force", out);
+}
+
+TEST_F(Cli, FlowBendingNetForceRemovalIsPartOfTheRun) {
+  // The option changes the run (the spheres' Method C force loses its net force and torque), is in
+  // its identity (a resume without it is refused), and leaves the run's identity as it was when off.
+  const fs::path a = dir / "keep", b = dir / "remove";
+  CliRun r = run("flow --cells 2" + kSmallTube + " --out " + a.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_FALSE(nlohmann::json::parse(r.out).contains("bending_without_net_force"));
+  r = run("flow --cells 2 --bending-net-force remove" + kSmallTube + " --out " + b.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(nlohmann::json::parse(r.out).at("bending_without_net_force").get<bool>());
+  EXPECT_NE(checkpoint_positions(a), checkpoint_positions(b));
+  r = run("flow --cells 2 --resume" + kSmallTube + " --out " + b.string());
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.err.find("bending_without_net_force"), std::string::npos) << r.err;
 }
 
 TEST_F(Cli, FlowWarnsOfAMeshCoarserThanTheLattice) {

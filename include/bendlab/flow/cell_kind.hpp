@@ -34,10 +34,13 @@ struct CellKindSpec {
   std::string method = "C";           ///< bending method ("none": no bending force)
   std::vector<std::string> method_options;  ///< name=value
   double volume_modulus_ratio = 100;  ///< kappa_V R / kappa_S of ESPResSo's volume force (R the radius)
+  /// Removes the bending force's net force and torque on each cell (membrane/rigid_projection.hpp).
+  bool bending_without_net_force = false;
 
   /// The fields that make a cell kind (a run's arguments): cell, cell_radius_um, mesh,
   /// elastic_law, shear_modulus, skalak_c, bending_modulus, method, method_options,
-  /// volume_modulus_ratio.
+  /// volume_modulus_ratio, and bending_without_net_force where it is set (so that the runs made
+  /// before the option keep their identity).
   nlohmann::json to_json() const;
 };
 

@@ -37,6 +37,10 @@ struct MembraneParameters {
   /// Spontaneous curvature and ADE of the bending energy (docs/conventions.md §5); its kappa_b is
   /// not used (kB above is). Plain (the default): the paper's bending force.
   BendingParameters bending_terms;
+  /// Removes the bending force's net force and net torque on the membrane (rigid_projection.hpp):
+  /// momentum-conserving bending for the methods whose discrete force has them (C, D, E, M).
+  /// Off (the default): the method's force as it is.
+  bool bending_without_net_force = false;
   /// The bending parameters the method receives: bending_terms with kappa_b = kB.
   BendingParameters bending_parameters() const {
     BendingParameters p = bending_terms;
