@@ -3,7 +3,7 @@
 Pries et al., and what the bending algorithm changes (`bendlab flow` runs; issue "Blood in a glass
 tube").
 
-    /usr/bin/python3 scripts/tube_study.py [--only diameters|hematocrit|methods|resolution|sensitivity|doc]
+    /usr/bin/python3 scripts/tube_study.py [--only diameters|hematocrit|methods|resolution|sensitivity|net_force|doc]
                                            [--t-end S] [--jobs N] [--methods LIST] [--bendlab PATH]
                                            [--work DIR]
                                            [--doc FILE] [--list]
@@ -16,8 +16,10 @@ Parts (each run one `bendlab flow` process):
   resolution  the D = 10 um, H_T = 0.3, Method C case with 5120-triangle cells.
   sensitivity the same case with the repulsion's cutoff halved (0.25 um) and with a periodic
               length of three diameters.
+  net_force   the same case with Methods C and D whose bending force's net force and torque are
+              removed on each cell (flow --bending-net-force remove).
   doc         only regenerates the document from the runs that are done.
-Without --only: methods, then diameters, hematocrit and resolution.
+Without --only: methods, then diameters, hematocrit, resolution, sensitivity and net_force.
 
 The model is the flow command's red blood cell with its cited defaults (docs/conventions.md §6:
 eq. (15) at R = 3.91 um, Skalak G_s = 5.3 uN/m, C = 10, kappa_B = 2e-19 J, 1280 triangles),
@@ -116,10 +118,12 @@ class Run(study_runner.StudyRun):
     t_end: float
     contact_cutoff: float = 0.0   # um; 0: the flow command's default, one dx
     length_factor: float = 2.0    # the periodic length in tube diameters
+    net_force: str = "keep"       # --bending-net-force: keep, or remove the bending force's net force
     start_arguments = ("--overwrite",)
 
     def arguments(self, out):
         extra = ["--contact-cutoff", fmt_g(self.contact_cutoff)] if self.contact_cutoff else []
+        extra += ["--bending-net-force", self.net_force] if self.net_force != "keep" else []
         return ["flow", "--geometry", "tube", "--diameter", fmt_g(self.diameter), "--length",
                 fmt_g(self.length_factor * self.diameter), "--dx", fmt_g(DX), "--tau", fmt_g(TAU),
                 "--pseudo-shear-rate", fmt_g(PSEUDO_SHEAR_RATE), "--hematocrit", fmt_g(self.hematocrit),
@@ -128,23 +132,27 @@ class Run(study_runner.StudyRun):
                 "--out", str(out)]
 
     def key(self):
-        return {"t_end": self.t_end, "diameter_um": self.diameter, "hematocrit": self.hematocrit,
-                "method": self.method, "mesh": self.mesh, "tau": TAU, "dx_um": DX,
-                "pseudo_shear_rate": PSEUDO_SHEAR_RATE, "seed": SEED, "contact_cutoff_um": self.contact_cutoff,
-                "length_um": self.length_factor * self.diameter}
+        k = {"t_end": self.t_end, "diameter_um": self.diameter, "hematocrit": self.hematocrit,
+             "method": self.method, "mesh": self.mesh, "tau": TAU, "dx_um": DX,
+             "pseudo_shear_rate": PSEUDO_SHEAR_RATE, "seed": SEED, "contact_cutoff_um": self.contact_cutoff,
+             "length_um": self.length_factor * self.diameter}
+        if self.net_force != "keep":  # the flow command's summary has the key only when it is set
+            k["bending_without_net_force"] = True
+        return k
 
     def label(self):
         extra = (f", cutoff {fmt_g(self.contact_cutoff)} um" if self.contact_cutoff else "") + (
-            f", L = {fmt_g(self.length_factor)} D" if self.length_factor != 2.0 else "")
+            f", L = {fmt_g(self.length_factor)} D" if self.length_factor != 2.0 else "") + (
+            ", net force removed" if self.net_force != "keep" else "")
         return (f"D = {fmt_g(self.diameter)} um, H_T {fmt_g(self.hematocrit)}, Method {self.method}, "
                 f"{self.mesh}{extra}")
 
 
-def run(D, H, method="C", mesh="mt1:1280", t_end=T_END, contact_cutoff=0.0, length_factor=2.0):
+def run(D, H, method="C", mesh="mt1:1280", t_end=T_END, contact_cutoff=0.0, length_factor=2.0, net_force="keep"):
     name = f"D{fmt_g(D)}_H{fmt_g(H)}_{method}_{mesh.replace(':', '')}"
     name += (f"_cut{fmt_g(contact_cutoff)}" if contact_cutoff else "") + (
-        f"_L{fmt_g(length_factor)}D" if length_factor != 2.0 else "")
-    return Run(name, D, H, method, mesh, t_end, contact_cutoff, length_factor)
+        f"_L{fmt_g(length_factor)}D" if length_factor != 2.0 else "") + ("_noNF" if net_force != "keep" else "")
+    return Run(name, D, H, method, mesh, t_end, contact_cutoff, length_factor, net_force)
 
 
 def parts(t_end, methods=METHODS):
@@ -155,6 +163,9 @@ def parts(t_end, methods=METHODS):
         "resolution": [run(10, 0.3, "C", "mt1:5120", t_end=t_end)],
         # What the departure from Pries' law could come from: the repulsion's reach and the period.
         "sensitivity": [run(10, 0.3, t_end=t_end, contact_cutoff=0.25), run(10, 0.3, t_end=t_end, length_factor=3.0)],
+        # Methods C and D with their bending force's net force and torque removed (--bending-net-force
+        # remove): whether that net force is what sets them apart from Method A.
+        "net_force": [run(10, 0.3, m, t_end=t_end, net_force="remove") for m in ("C", "D")],
     }
 
 
@@ -464,6 +475,42 @@ def departure_evidence(work, all_parts):
     return L + [""]
 
 
+def net_force_removed_section(work, all_parts, table_of):
+    """The methods runs beside their twins without the bending force's net force and torque: each
+    twin against its plain run and against Method A, in standard errors."""
+    if not all_parts.get("net_force"):
+        return []
+    methods = {r.method: r for r in all_parts["methods"]}
+    rows = [methods[m] for m in ("A",) if m in methods]
+    for r in all_parts["net_force"]:
+        rows += [methods[r.method]] if r.method in methods else []
+        rows.append(r)
+    L = ["## The bending force without its net force", "",
+         "Methods C and D with their bending force's net force and torque taken off each cell "
+         "(`--bending-net-force remove`, docs/conventions.md §6), beside their plain runs and Method A, whose "
+         "force has none to take off:", ""]
+    L += table_of({"rows": rows}, "rows", "run", lambda r: f"Method {r.method}" + (
+        ", net force removed" if r.net_force != "keep" else ""))
+
+    def diff(a, b):
+        sa, sb = done(a, work), done(b, work)
+        if sa is None or sb is None:
+            return None
+        (ea, sea), (eb, seb) = mean_se(sa, "apparent_viscosity"), mean_se(sb, "apparent_viscosity")
+        se = math.hypot(sea, seb)
+        return f"{ea - eb:+.3g} ({(ea - eb) / se if se > 0 else math.inf:+.1f} standard errors)"
+    lines = []
+    for r in all_parts["net_force"]:
+        plain, a = methods.get(r.method), methods.get("A")
+        parts = [f"against plain Method {r.method} {d}" for d in [diff(r, plain) if plain else None] if d] + [
+            f"against Method A {d}" for d in [diff(r, a) if a else None] if d]
+        if parts:
+            lines.append(f"Method {r.method} without its net force: eta_app " + ", ".join(parts))
+    if lines:
+        L += ["; ".join(lines) + ".", ""]
+    return L
+
+
 def write_doc(argv, work, doc, all_parts, binary_commit=None, bendlab=None):
     import matplotlib
     matplotlib.use("Agg")
@@ -552,6 +599,7 @@ def write_doc(argv, work, doc, all_parts, binary_commit=None, bendlab=None):
         L += ["Against Method C: " + "; ".join(lines) + ". A difference beyond about two standard errors is "
               "one the runs resolve; a smaller one is noise at this run length.", ""]
     L += answer(bendlab, work, all_parts["methods"])
+    L += net_force_removed_section(work, all_parts, table_of)
     # Every finished run against the laws, as the issue's acceptance reads them.
     against = []
     for r, s_ in have:
@@ -688,7 +736,8 @@ def render_cells(vtp, summary, png):
 
 def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--only", choices=["methods", "diameters", "hematocrit", "resolution", "sensitivity", "doc"],
+    p.add_argument("--only", choices=["methods", "diameters", "hematocrit", "resolution", "sensitivity", "net_force",
+                                      "doc"],
                    default=None)
     p.add_argument("--t-end", type=float, default=T_END, help="end of every run, s")
     p.add_argument("--jobs", type=int, default=1)
@@ -704,7 +753,7 @@ def main():
     work, doc = Path(a.work), Path(a.doc)
     work.mkdir(parents=True, exist_ok=True)
     all_parts = parts(a.t_end, [m for m in a.methods.split(",") if m])
-    order = ["methods", "diameters", "hematocrit", "resolution", "sensitivity"]
+    order = ["methods", "diameters", "hematocrit", "resolution", "sensitivity", "net_force"]
     todo = [] if a.only == "doc" else (all_parts[a.only] if a.only else [r for k in order for r in all_parts[k]])
     if a.list:
         return study_runner.Runner(a.bendlab, work).list(todo, f"part {a.only or 'all'}")
