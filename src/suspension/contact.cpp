@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdint>
 
 namespace bendlab {
 
@@ -91,9 +90,9 @@ void ContactSearch::bin(const Vessel& vessel, const Points& x, const std::vector
     }
 }
 
-template <class Visit>
+template <bool kBothSides, class Visit, class EndOfVertex>
 void ContactSearch::for_each_pair(const Vessel& vessel, const Points& x, const std::vector<int>& cell_of, double range,
-                                  Visit&& visit) {
+                                  Visit&& visit, EndOfVertex&& end_of_vertex) {
   if (static_cast<Eigen::Index>(cell_of.size()) != x.rows()) {
     throw Error(fmt::format("contact search: {} cell indices for {} vertices", cell_of.size(), x.rows()));
   }
@@ -158,7 +157,7 @@ void ContactSearch::for_each_pair(const Vessel& vessel, const Points& x, const s
             for (int s = start_[nb]; s < start_[nb + 1]; ++s) {
               if (sorted_cell_[s] == ci) continue;
               const int j = items_[s];
-              if (j <= i) continue;
+              if (!kBothSides && j <= i) continue;
               Vec3 d;
               if (shifted_images) {
                 d = Vec3(ox - sorted_(s, 0), oy - sorted_(s, 1), oz - sorted_(s, 2));
@@ -171,35 +170,39 @@ void ContactSearch::for_each_pair(const Vessel& vessel, const Points& x, const s
           }
         }
       }
+      end_of_vertex(i);
     }
   }
 }
 
 double ContactSearch::add_cell_contact(const Vessel& vessel, const ContactLaw& law, const Points& x,
                                        const std::vector<int>& cell_of, Points& F) {
-  // The pairs are found in bin order, which depends on every vertex's position (the bins of an
-  // axis without a period span the vertices present); they are added in the order of their rows
-  // (i, j) instead, so that a vertex's force is summed over its partners in row order whatever the
-  // other vertices are: a rank that holds only the cells near its own gets the serial force.
-  pairs_.clear();
-  for_each_pair(vessel, x, cell_of, law.cutoff, [&](int i, int j, const Vec3& d, double r) {
-    pairs_.push_back(Pair{(static_cast<std::uint64_t>(i) << 32) | static_cast<std::uint32_t>(j), d, r});
-  });
-  std::sort(pairs_.begin(), pairs_.end(), [](const Pair& a, const Pair& b) { return a.rows < b.rows; });
+  // Each vertex's force is summed over its partners in the order of their rows, not in the order
+  // the bins give them (which depends on every vertex's position: the bins of an axis without a
+  // period span the vertices present), so that it does not depend on the vertices beyond the
+  // cutoff: a rank that holds only the cells near its own gets the serial force. Every pair is
+  // found from both of its vertices, and each adds its own side; the energy counts a pair once.
   double energy = 0;
-  for (const Pair& p : pairs_) {
-    energy += law.energy(p.r);
-    if (p.r == 0) continue;  // no direction: the neighbours' pushes separate the two
-    const Vec3 f = law.force(p.r) / p.r * p.d;
-    F.row(static_cast<Eigen::Index>(p.rows >> 32)) += f.transpose();
-    F.row(static_cast<Eigen::Index>(p.rows & 0xffffffffu)) -= f.transpose();
-  }
+  partners_.clear();
+  for_each_pair<true>(
+      vessel, x, cell_of, law.cutoff,
+      [&](int i, int j, const Vec3& d, double r) {
+        partners_.push_back(Partner{j, d, r});
+        if (j > i) energy += law.energy(r);
+      },
+      [&](int i) {
+        if (partners_.empty()) return;
+        std::sort(partners_.begin(), partners_.end(), [](const Partner& a, const Partner& b) { return a.row < b.row; });
+        for (const Partner& p : partners_)
+          if (p.r > 0) F.row(i) += (law.force(p.r) / p.r * p.d).transpose();  // r = 0: no direction
+        partners_.clear();
+      });
   return energy;
 }
 
 double ContactSearch::min_cell_distance(const Vessel& vessel, const Points& x, const std::vector<int>& cell_of, double range) {
   double m = range;
-  for_each_pair(vessel, x, cell_of, range, [&](int, int, const Vec3&, double r) { m = std::min(m, r); });
+  for_each_pair<false>(vessel, x, cell_of, range, [&](int, int, const Vec3&, double r) { m = std::min(m, r); }, [](int) {});
   return m;
 }
 

@@ -15,7 +15,6 @@
 // nearest periodic image (the image in the neighbour bin, or Vessel::minimum_image where an axis
 // has fewer than three bins), so positions may be unwrapped. ContactSearch
 // keeps its bins between calls: once warm it allocates nothing.
-#include <cstdint>
 #include <vector>
 
 #include "bendlab/core/types.hpp"
@@ -41,7 +40,10 @@ class ContactSearch {
   /// to F; returns the energy summed over the pairs. Each vertex's force is added pair by pair in
   /// the order of its partners' rows, so it does not depend on vertices beyond the cutoff (nor on
   /// the bins they make): rows of x that keep their order and their neighbours give the same
-  /// forces bit for bit (the MPI suspension holds only the cells near a rank's slab).
+  /// forces bit for bit (the MPI suspension holds only the cells near a rank's slab). A pair is
+  /// found from both of its vertices, each adding its own side, so nothing is stored per pair
+  /// (Newton's third law then holds to round-off: the two sides' separations are the nearest
+  /// image taken from either end).
   double add_cell_contact(const Vessel& vessel, const ContactLaw& law, const Points& x,
                           const std::vector<int>& cell_of, Points& F);
   /// The smallest distance between vertices of different cells closer than `range` (range if
@@ -52,19 +54,22 @@ class ContactSearch {
   // Bins the rows of x (bins at least `width` wide), with their positions wrapped into the period
   // and, in bin order, those positions and cells; the pairs then come from for_each_pair.
   void bin(const Vessel& vessel, const Points& x, const std::vector<int>& cell_of, double width);
-  template <class Visit>
-  void for_each_pair(const Vessel& vessel, const Points& x, const std::vector<int>& cell_of, double range, Visit&& visit);
+  // visit(i, j, d, r) for the pairs closer than range, i < j (or every ordered pair with
+  // kBothSides), grouped by i, with end_of_vertex(i) after each i's partners.
+  template <bool kBothSides, class Visit, class EndOfVertex>
+  void for_each_pair(const Vessel& vessel, const Points& x, const std::vector<int>& cell_of, double range, Visit&& visit,
+                     EndOfVertex&& end_of_vertex);
 
   int nb_[3] = {0, 0, 0};
   double lo_[3] = {0, 0, 0}, w_[3] = {1, 1, 1};
   static constexpr int kEmptyBin = -1, kMixedBin = -2;
   std::vector<int> bin_of_, start_, items_, sorted_cell_, bin_cell_;
-  struct Pair {
-    std::uint64_t rows;  // i << 32 | j, i < j
-    Vec3 d;              // x_i - x_j (nearest image)
+  struct Partner {
+    int row;  // j
+    Vec3 d;   // x_i - x_j (nearest image)
     double r;
   };
-  std::vector<Pair> pairs_;
+  std::vector<Partner> partners_;  // of one vertex i
   Points wrapped_, sorted_;
 };
 
