@@ -29,22 +29,12 @@
 #include "bendlab/flow/lbm/lbm_suspension.hpp"
 #include "bendlab/flow/lbm/physical_units.hpp"
 #include "bendlab/suspension/placement.hpp"
+#include "pipeflow_case.hpp"
 
 using namespace bendlab;
 using namespace bendlab::lbm;
 
 namespace {
-
-FlowUnits pipeflow_units() {
-  FlowUnitsInput in;
-  in.geometry = FlowGeometry::Tube;
-  in.diameter_um = 25;
-  in.length_um = 50;
-  in.dx_um = 0.5;
-  in.tau = 1.0;
-  in.pseudo_shear_rate = 100;
-  return flow_units(in);
-}
 
 // The heap the process has in use, bytes (glibc's mallinfo2: allocated blocks, mapped ones
 // included; blocks freed but kept by the allocator are not counted, as the resident set would).
@@ -54,55 +44,8 @@ double heap_in_use() {
 }
 
 std::unique_ptr<LbmSuspension> pipeflow(bool with_cells, double hematocrit = 0) {
-  const FlowUnits u = pipeflow_units();
-  SuspensionOptions o;
-  o.lattice = flow_lattice_config(u);
-  o.vessel = Vessel::tube(u.section_lattice, u.nx);
-  const double cutoff = 1.0;
-  o.cell_contact = ContactLaw{u.to_lattice_force(1e-12), cutoff};
-  o.wall_contact = ContactLaw{u.to_lattice_force(1e-12), cutoff};
-  auto s = std::make_unique<LbmSuspension>(o);
-  if (!with_cells) return s;
-  const CellKind rbc = make_cell_kind(CellKindSpec{});
-  CellKindSpec small;
-  small.shape = "sphere";
-  small.radius_um = 1.5;
-  small.mesh = "mt1:320";
-  small.shear_modulus = 10 * 5.3e-6;
-  const CellKind stiff = make_cell_kind(small);
-  const Vessel tube_um = Vessel::tube(25, 50);
-  PlacementOptions p;
-  if (hematocrit > 0) {
-    p.hematocrit = hematocrit;
-  } else {
-    p.count = 36;
-  }
-  p.clearance = 0.25;
-  p.seed = 1;
-  const Placement reds = place_cells(tube_um, rbc.reference_um.topology(), rbc.reference_um.positions(), p);
-  const auto red_membrane = lattice_membrane(rbc, u);
-  const auto stiff_membrane = lattice_membrane(stiff, u);
-  for (const PlacedCell& c : reds.cells) s->add_cell(red_membrane, placed_positions(rbc.reference_um.positions(), c) / u.input.dx_um);
-  if (hematocrit > 0) return s;
-  // The small cells where the red ones leave room: placed among them by trying positions.
-  int added = 0;
-  for (int k = 0; k < 400 && added < 6; ++k) {
-    PlacedCell c;
-    c.centre = Vec3(-25.0 + 50.0 * ((k * 37) % 100) / 100.0, 9.0 * std::cos(k), 9.0 * std::sin(k));
-    const Points x = placed_positions(stiff.reference_um.positions(), c) / u.input.dx_um;
-    bool clear = true;
-    for (Eigen::Index i = 0; i < x.rows() && clear; ++i) {
-      for (Eigen::Index j = 0; j < s->positions().rows() && clear; ++j) {
-        Vec3 d = row(x, i) - row(s->positions(), j);
-        d.x() -= u.nx * std::round(d.x() / u.nx);
-        clear = d.norm() > 1.0;
-      }
-    }
-    if (clear) {
-      s->add_cell(stiff_membrane, x);
-      ++added;
-    }
-  }
+  auto s = std::make_unique<LbmSuspension>(bench::pipeflow_options());
+  if (with_cells) bench::add_pipeflow_cells(*s, hematocrit, [&] { return s->positions(); });
   return s;
 }
 
