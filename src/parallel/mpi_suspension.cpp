@@ -283,13 +283,45 @@ void MpiSuspension::spread_and_step(std::int64_t n) {
   fluid_.step();
 }
 
+void MpiSuspension::compute_stencil_velocities() {
+  // The velocity of every node of this rank's layers in some held stencil, once (a membrane with
+  // about a vertex per dx visits each node about four times), in the order of the local nodes'
+  // indices so that the population arrays are read front to back, as IbInterpolator does.
+  const SlabDecomposition& slab = fluid_.slab();
+  const lbm::Lattice& lat = fluid_.local();
+  const std::size_t n = lat.num_nodes();
+  marks_.assign((n + 63) / 64, 0);
+  for (const lbm::IbStencil& st : stencils_)
+    for (int s = 0; s < st.size; ++s) {
+      if (st.weight[s] == 0.0 || !slab.owns(static_cast<int>(layer(st.node[s])))) continue;
+      const std::size_t node = local_node(st.node[s]);
+      marks_[node / 64] |= std::uint64_t{1} << (node % 64);
+    }
+  touched_.clear();
+  for (std::size_t w = 0; w < marks_.size(); ++w)
+    for (std::uint64_t bits = marks_[w]; bits != 0; bits &= bits - 1)
+      touched_.push_back(64 * w + static_cast<std::size_t>(__builtin_ctzll(bits)));
+  if (node_velocity_.size() != 3 * n) node_velocity_.assign(3 * n, 0.0);
+  const auto touched = static_cast<std::ptrdiff_t>(touched_.size());
+#pragma omp parallel for schedule(static) if (touched >= 4096)
+  for (std::ptrdiff_t t = 0; t < touched; ++t) {
+    const std::size_t node = touched_[static_cast<std::size_t>(t)];
+    const Vec3 v = lat.velocity(node);
+    node_velocity_[3 * node] = v.x(), node_velocity_[3 * node + 1] = v.y(), node_velocity_[3 * node + 2] = v.z();
+  }
+}
+
 void MpiSuspension::interpolate_and_move(std::int64_t n) {
   // f. The velocities of the stencil nodes in this rank's layers that the other owners' vertices
   // need, in the order of their cells, rows and stencil entries; the owners read them in the same
   // order.
   const SlabDecomposition& slab = fluid_.slab();
   const int me = slab.rank;
-  const lbm::Lattice& lat = fluid_.local();
+  compute_stencil_velocities();
+  auto velocity = [&](std::size_t global_node) {
+    const double* v = node_velocity_.data() + 3 * local_node(global_node);
+    return Vec3(v[0], v[1], v[2]);
+  };
   std::vector<std::vector<double>> send(static_cast<std::size_t>(slab.ranks));
   std::size_t at = 0;
   for (int c : held_) {
@@ -299,7 +331,7 @@ void MpiSuspension::interpolate_and_move(std::int64_t n) {
       const lbm::IbStencil& st = stencils_[at];
       for (int s = 0; s < st.size; ++s) {
         if (st.weight[s] == 0.0 || !slab.owns(static_cast<int>(layer(st.node[s])))) continue;
-        const Vec3 v = lat.velocity(local_node(st.node[s]));
+        const Vec3 v = velocity(st.node[s]);
         send[static_cast<std::size_t>(o)].insert(send[static_cast<std::size_t>(o)].end(), {v.x(), v.y(), v.z()});
       }
     }
@@ -325,7 +357,7 @@ void MpiSuspension::interpolate_and_move(std::int64_t n) {
         const int t = slab.owner(static_cast<int>(layer(st.node[s])));
         Vec3 v;
         if (t == me) {
-          v = lat.velocity(local_node(st.node[s]));
+          v = velocity(st.node[s]);
         } else {
           std::size_t& i = next[static_cast<std::size_t>(t)];
           v = Vec3(in[i], in[i + 1], in[i + 2]);

@@ -108,6 +108,7 @@ class MpiSuspension {
   void agree();
   void compute_forces(std::int64_t n);
   void spread_and_step(std::int64_t n);
+  void compute_stencil_velocities();
   void interpolate_and_move(std::int64_t n);
   void wrap(int c);
   // The y-layer of a global node index, and the local node of a global node in an owned layer.
@@ -131,6 +132,9 @@ class MpiSuspension {
   Points held_x_, held_f_;
   std::vector<int> held_cell_of_;
   std::vector<lbm::IbStencil> stencils_;  // per row of the held cells, in held order
+  std::vector<std::uint64_t> marks_;      // a bit per local node: in some stencil
+  std::vector<std::size_t> touched_;      // the marked local nodes, ascending
+  std::vector<double> node_velocity_;     // 3 per local node (those touched are current)
   std::string failure_;
 };
 
