@@ -57,8 +57,8 @@ with tempfile.TemporaryDirectory() as d:
 
 # Many cells: each rank owns whole cells (docs/mpi.md, "Many cells").
 FLOW = ["flow", "--geometry", "tube", "--diameter", "9", "--length", "12", "--dx", "0.5", "--tau", "1",
-        "--pseudo-shear-rate", "100", "--cells", "2", "--mesh", "mt1:320", "--t-end", "2e-4", "--sample-every", "2e-5",
-        "--snapshot-every", "1e-4"]
+        "--pseudo-shear-rate", "100", "--cells", "2", "--mesh", "mt1:320", "--t-end", "4e-5", "--sample-every", "4e-6",
+        "--snapshot-every", "2e-5"]
 
 
 def same_files(a, b, what, but=("timing.json",)):
