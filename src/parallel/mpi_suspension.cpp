@@ -12,6 +12,8 @@ namespace bendlab::parallel {
 
 namespace {
 
+constexpr std::size_t kNotHere = std::numeric_limits<std::size_t>::max();  // a node in another rank's layers
+
 // Sends send[r] to every rank r and returns what each rank sent here, with the counts exchanged
 // first (collective).
 std::vector<double> all_to_all(const std::vector<std::vector<double>>& send, MPI_Comm comm, std::vector<int>& from_rank) {
@@ -242,42 +244,62 @@ void MpiSuspension::compute_forces(std::int64_t n) {
   }
 }
 
-std::size_t MpiSuspension::layer(std::size_t node) const {
+std::string MpiSuspension::make_stencil(Eigen::Index k, std::size_t at) {
   const lbm::LatticeConfig& g = fluid_.config();
-  return (node / static_cast<std::size_t>(g.nx)) % static_cast<std::size_t>(g.ny);
-}
-
-std::size_t MpiSuspension::local_node(std::size_t node) const {
-  const lbm::LatticeConfig& g = fluid_.config();
-  const std::size_t r = node / static_cast<std::size_t>(g.nx);
-  return fluid_.local_node(static_cast<int>(node % static_cast<std::size_t>(g.nx)), static_cast<int>(r % static_cast<std::size_t>(g.ny)),
-                           static_cast<int>(r / static_cast<std::size_t>(g.ny)));
+  const SlabDecomposition& slab = fluid_.slab();
+  lbm::IbStencil st;
+  std::string error;
+  try {
+    st = lbm::ib_stencil({g.nx, g.ny, g.nz}, g.walls, row(X_, k), options_.kernel);
+  } catch (const Error& e) {
+    error = e.what();
+    st.size = 0;
+  }
+  const auto nx = static_cast<std::size_t>(g.nx), ny = static_cast<std::size_t>(g.ny);
+  for (int s = 0; s < per_row_; ++s, ++at) {
+    entry_weight_[at] = s < st.size ? st.weight[s] : 0.0;
+    if (entry_weight_[at] == 0.0) continue;
+    const std::size_t node = st.node[s], line = node / nx;  // node = i + nx (j + ny k)
+    const int i = static_cast<int>(node - nx * line), j = static_cast<int>(line % ny), kz = static_cast<int>(line / ny);
+    entry_owner_[at] = slab.owner(j);
+    if (slab.owns(j)) entry_local_[at] = fluid_.local_node(i, j, kz);
+  }
+  return error;
 }
 
 void MpiSuspension::spread_and_step(std::int64_t n) {
-  // d. The stencils of every held row, and the forces onto this rank's layers, row after row in
-  // the order of the cells' indices: each node sums the serial terms in the serial order. A stencil
-  // that cannot be made (a non-finite position, a support across a wall) fails alike on every rank
-  // that holds the row, and is left empty so that the exchanges below stay matched.
-  const lbm::LatticeConfig& g = fluid_.config();
-  const SlabDecomposition& slab = fluid_.slab();
+  // d. The stencils of every held row (on OpenMP threads), then the forces onto this rank's
+  // layers, row after row in the order of the cells' indices: each node sums the serial terms in
+  // the serial order. A stencil that cannot be made (a non-finite position, a support across a
+  // wall) fails alike on every rank that holds the row, and is left with zero weights so that the
+  // exchanges below stay matched.
+  const int m = static_cast<int>(std::ceil(lbm::ib_kernel_half_width(options_.kernel)));
+  per_row_ = 8 * m * m * m;  // (2 m)^3
+  std::vector<Eigen::Index> held_rows;  // global row of each held row, in held order
+  for (int c : held_)
+    for (Eigen::Index k = first_row(c); k < first_row(c) + rows(c); ++k) held_rows.push_back(k);
+  const std::size_t entries = held_rows.size() * static_cast<std::size_t>(per_row_);
+  entry_weight_.resize(entries);
+  entry_owner_.resize(entries);
+  entry_local_.assign(entries, kNotHere);
+  const auto count = static_cast<std::ptrdiff_t>(held_rows.size());
+  std::ptrdiff_t first_failure = count;
+  std::string failure;
+#pragma omp parallel for schedule(static) if (count >= 1024)
+  for (std::ptrdiff_t r = 0; r < count; ++r) {
+    const std::string error = make_stencil(held_rows[static_cast<std::size_t>(r)], static_cast<std::size_t>(r) * per_row_);
+    if (!error.empty()) {
+#pragma omp critical
+      if (r < first_failure) first_failure = r, failure = error;
+    }
+  }
+  if (first_failure < count) fail(fmt::format("suspension step {}: IB node {}: {}", n, held_rows[static_cast<std::size_t>(first_failure)], failure));
   lbm::Lattice& lat = fluid_.local();
   lat.clear_force();
-  stencils_.clear();
-  for (int c : held_) {
-    for (Eigen::Index k = first_row(c); k < first_row(c) + rows(c); ++k) {
-      lbm::IbStencil st;
-      try {
-        st = lbm::ib_stencil({g.nx, g.ny, g.nz}, g.walls, row(X_, k), options_.kernel);
-      } catch (const Error& e) {
-        fail(fmt::format("suspension step {}: IB node {}: {}", n, k, e.what()));
-        st.size = 0;
-      }
-      const Vec3 Fk = row(F_, k);
-      for (int s = 0; s < st.size; ++s)
-        if (st.weight[s] != 0.0 && slab.owns(static_cast<int>(layer(st.node[s])))) lat.add_force(local_node(st.node[s]), st.weight[s] * Fk);
-      stencils_.push_back(st);
-    }
+  for (std::ptrdiff_t r = 0; r < count; ++r) {
+    const Vec3 Fk = row(F_, held_rows[static_cast<std::size_t>(r)]);
+    for (std::size_t e = static_cast<std::size_t>(r) * per_row_, end = e + per_row_; e < end; ++e)
+      if (entry_weight_[e] != 0.0 && entry_local_[e] != kNotHere) lat.add_force(entry_local_[e], entry_weight_[e] * Fk);
   }
   // e.
   fluid_.step();
@@ -287,16 +309,13 @@ void MpiSuspension::compute_stencil_velocities() {
   // The velocity of every node of this rank's layers in some held stencil, once (a membrane with
   // about a vertex per dx visits each node about four times), in the order of the local nodes'
   // indices so that the population arrays are read front to back, as IbInterpolator does.
-  const SlabDecomposition& slab = fluid_.slab();
   const lbm::Lattice& lat = fluid_.local();
   const std::size_t n = lat.num_nodes();
   marks_.assign((n + 63) / 64, 0);
-  for (const lbm::IbStencil& st : stencils_)
-    for (int s = 0; s < st.size; ++s) {
-      if (st.weight[s] == 0.0 || !slab.owns(static_cast<int>(layer(st.node[s])))) continue;
-      const std::size_t node = local_node(st.node[s]);
-      marks_[node / 64] |= std::uint64_t{1} << (node % 64);
-    }
+  for (std::size_t e = 0; e < entry_local_.size(); ++e) {
+    const std::size_t node = entry_local_[e];
+    if (entry_weight_[e] != 0.0 && node != kNotHere) marks_[node / 64] |= std::uint64_t{1} << (node % 64);
+  }
   touched_.clear();
   for (std::size_t w = 0; w < marks_.size(); ++w)
     for (std::uint64_t bits = marks_[w]; bits != 0; bits &= bits - 1)
@@ -318,22 +337,20 @@ void MpiSuspension::interpolate_and_move(std::int64_t n) {
   const SlabDecomposition& slab = fluid_.slab();
   const int me = slab.rank;
   compute_stencil_velocities();
-  auto velocity = [&](std::size_t global_node) {
-    const double* v = node_velocity_.data() + 3 * local_node(global_node);
-    return Vec3(v[0], v[1], v[2]);
-  };
+  const auto per_row = static_cast<std::size_t>(per_row_);
   std::vector<std::vector<double>> send(static_cast<std::size_t>(slab.ranks));
-  std::size_t at = 0;
+  std::size_t at = 0;  // the held row's first entry
   for (int c : held_) {
     const int o = owner_[c];
-    for (Eigen::Index k = 0; k < rows(c); ++k, ++at) {
-      if (o == me) continue;
-      const lbm::IbStencil& st = stencils_[at];
-      for (int s = 0; s < st.size; ++s) {
-        if (st.weight[s] == 0.0 || !slab.owns(static_cast<int>(layer(st.node[s])))) continue;
-        const Vec3 v = velocity(st.node[s]);
-        send[static_cast<std::size_t>(o)].insert(send[static_cast<std::size_t>(o)].end(), {v.x(), v.y(), v.z()});
-      }
+    if (o == me) {
+      at += static_cast<std::size_t>(rows(c)) * per_row;
+      continue;
+    }
+    std::vector<double>& out = send[static_cast<std::size_t>(o)];
+    for (const std::size_t end = at + static_cast<std::size_t>(rows(c)) * per_row; at < end; ++at) {
+      if (entry_weight_[at] == 0.0 || entry_local_[at] == kNotHere) continue;
+      const double* v = node_velocity_.data() + 3 * entry_local_[at];
+      out.insert(out.end(), v, v + 3);
     }
   }
   std::vector<int> from;
@@ -345,25 +362,23 @@ void MpiSuspension::interpolate_and_move(std::int64_t n) {
   at = 0;
   for (int c : held_) {
     if (owner_[c] != me) {
-      at += static_cast<std::size_t>(rows(c));
+      at += static_cast<std::size_t>(rows(c)) * per_row;
       continue;
     }
-    for (Eigen::Index k = first_row(c); k < first_row(c) + rows(c); ++k, ++at) {
-      const lbm::IbStencil& st = stencils_[at];
+    for (Eigen::Index k = first_row(c); k < first_row(c) + rows(c); ++k) {
       Vec3 u = Vec3::Zero();
-      for (int s = 0; s < st.size; ++s) {
-        const double w = st.weight[s];
+      for (const std::size_t end = at + per_row; at < end; ++at) {
+        const double w = entry_weight_[at];
         if (w == 0.0) continue;
-        const int t = slab.owner(static_cast<int>(layer(st.node[s])));
-        Vec3 v;
-        if (t == me) {
-          v = velocity(st.node[s]);
+        const double* v;
+        if (entry_local_[at] != kNotHere) {
+          v = node_velocity_.data() + 3 * entry_local_[at];
         } else {
-          std::size_t& i = next[static_cast<std::size_t>(t)];
-          v = Vec3(in[i], in[i + 1], in[i + 2]);
+          std::size_t& i = next[static_cast<std::size_t>(entry_owner_[at])];
+          v = in.data() + i;
           i += 3;
         }
-        u += w * v;
+        u += w * Vec3(v[0], v[1], v[2]);
       }
       U_.row(k) = u.transpose();
     }

@@ -111,9 +111,10 @@ class MpiSuspension {
   void compute_stencil_velocities();
   void interpolate_and_move(std::int64_t n);
   void wrap(int c);
-  // The y-layer of a global node index, and the local node of a global node in an owned layer.
-  std::size_t layer(std::size_t node) const;
-  std::size_t local_node(std::size_t node) const;
+  // The stencil of global row k (a row of a held cell) as entries from `at` on: each entry's
+  // weight, the rank that owns its node's layer and, where that is this rank, its local node.
+  // A stencil that cannot be made leaves zero weights and returns the reason.
+  std::string make_stencil(Eigen::Index k, std::size_t at);
 
   lbm::SuspensionOptions options_;
   DistributedLattice fluid_;
@@ -131,7 +132,12 @@ class MpiSuspension {
   ContactSearch contact_;
   Points held_x_, held_f_;
   std::vector<int> held_cell_of_;
-  std::vector<lbm::IbStencil> stencils_;  // per row of the held cells, in held order
+  // The stencils of the held cells' rows, in held order, per_row_ entries each (zero weights
+  // kept): 20 bytes an entry, where an lbm::IbStencil is 1 kB a row whatever the kernel.
+  int per_row_ = 0;
+  std::vector<double> entry_weight_;
+  std::vector<int> entry_owner_;             // the rank owning the entry node's layer
+  std::vector<std::size_t> entry_local_;     // its local node where that rank is this one
   std::vector<std::uint64_t> marks_;      // a bit per local node: in some stencil
   std::vector<std::size_t> touched_;      // the marked local nodes, ascending
   std::vector<double> node_velocity_;     // 3 per local node (those touched are current)
