@@ -351,9 +351,10 @@ def net_force_section(bendlab, work, runs):
             "the plasma and the plasma the other way: a force the physics does not have.", ""] + L
 
 
-def answer(bendlab, work, runs):
+def answer(bendlab, work, runs, without_net_force=()):
     """The stated answer to "does the bending algorithm change what the suspension does, and which
-    should a user pick", from the runs of the methods part and the net forces on their cells."""
+    should a user pick", from the runs of the methods part, the net forces on their cells and the
+    runs whose bending force has its net force removed (without_net_force)."""
     rows = [(r, done(r, work)) for r in runs]
     ran = [(r, s) for r, s in rows if s is not None]
     failed = [(r, failure(r, work)) for r, s in rows if s is None and failure(r, work)]
@@ -405,7 +406,12 @@ def answer(bendlab, work, runs):
     exact = [m for m in ran_methods if worst.get(m, 1.0) < 1e-9]
     unfit = sorted({r.method for r, _ in failed})
     usable = [m for m in ran_methods if m not in exact and m not in unfit]
+    L[-1] += without_net_force_answer(work, eta, without_net_force)
     pick = []
+    removed = sorted(r.method for r in without_net_force if done(r, work) is not None and r.method in eta)
+    if len(removed) >= 2:
+        pick.append(f"Method {' or '.join(removed)} with its net force removed (`--bending-net-force remove`): "
+                    "they then come together, as above")
     if exact:
         pick.append(f"a method whose force is the exact gradient of a discrete energy (Method {', '.join(exact)} "
                     "here; B and J are of the same kind): its net force and torque on every cell vanish by "
@@ -423,6 +429,31 @@ def answer(bendlab, work, runs):
                                                  "on the shapes below" if m in worst else "") for m in unfit) + ".")
     L[-1] += " Which figures have converged is the resolution section's question, not this table's."
     return L + [""]
+
+
+def without_net_force_answer(work, eta, runs):
+    """What removing the bending force's net force does to the methods' spread of eta_app (eta: the
+    plain runs' (mean, standard error) per method), or "" while fewer than two of those runs are done."""
+    clean = {r.method: mean_se(s, "apparent_viscosity") for r in runs if (s := done(r, work)) is not None}
+    clean = {m: v for m, v in clean.items() if m in eta}
+    if len(clean) < 2:
+        return ""
+    lo, hi = min(clean, key=lambda m: clean[m][0]), max(clean, key=lambda m: clean[m][0])
+    before = abs(eta[hi][0] - eta[lo][0])
+    after = clean[hi][0] - clean[lo][0]
+    z = after / math.hypot(clean[hi][1], clean[lo][1])
+    text = (f" With their net force and torque removed on each cell (the section below), Methods {lo} and {hi} "
+            f"give eta_app / eta = {num(clean[lo][0])} and {num(clean[hi][0])}: {after:.2g} apart "
+            f"({z:.0f} standard errors) where the plain runs were {before:.3g} apart")
+    if "none" in eta:
+        off = max(abs(v[0] - eta["none"][0]) for v in clean.values())
+        text += f", and within {off:.2g} of the run without bending"
+    if "A" in eta:
+        text += f" (Method A, whose force has no net force to remove: {eta['A'][0] - eta['none'][0]:+.3g} from it)" \
+            if "none" in eta else ""
+    text += (f". Most of what separated Methods {lo} and {hi} in a suspension was the net force their "
+             f"discretisation leaves on a cell, not their bending; `flow --bending-net-force remove` takes it off.")
+    return text
 
 
 def departure_evidence(work, all_parts):
@@ -598,7 +629,7 @@ def write_doc(argv, work, doc, all_parts, binary_commit=None, bendlab=None):
                          f"errors of the difference)")
         L += ["Against Method C: " + "; ".join(lines) + ". A difference beyond about two standard errors is "
               "one the runs resolve; a smaller one is noise at this run length.", ""]
-    L += answer(bendlab, work, all_parts["methods"])
+    L += answer(bendlab, work, all_parts["methods"], all_parts["net_force"])
     L += net_force_removed_section(work, all_parts, table_of)
     # Every finished run against the laws, as the issue's acceptance reads them.
     against = []
