@@ -506,6 +506,31 @@ def departure_evidence(work, all_parts):
     return L + [""]
 
 
+def resolution_verdict(work, runs):
+    """Which of the D = 10 um, H_T 0.3, Method C run's figures have converged with the cells' mesh:
+    each figure of the finest run against the coarsest, in standard errors of the difference and
+    relative, beside the departure from the laws that it would have to explain."""
+    finished = [(r, s) for r in runs if (s := done(r, work)) is not None]
+    if len(finished) < 2:
+        return []
+    (rc, sc), (rf, sf) = finished[0], finished[-1]
+    parts = []
+    for key, what in (("apparent_viscosity", "eta_app / eta"), ("discharge_hematocrit", "H_D"),
+                      ("cell_free_layer_um", "the cell-free layer")):
+        (ec, sec), (ef, sef) = mean_se(sc, key), mean_se(sf, key)
+        se = math.hypot(sec, sef)
+        z = (ef - ec) / se if se > 0 else math.inf
+        parts.append(f"{what} {num(ec)} -> {num(ef)} ({(ef - ec) / ec:+.1%}, {z:+.1f} standard errors of the "
+                     "difference)")
+    law_c = pries_in_vitro(rc.diameter, mean_se(sc, "discharge_hematocrit")[0])
+    law_f = pries_in_vitro(rf.diameter, mean_se(sf, "discharge_hematocrit")[0])
+    ec, ef = mean_se(sc, "apparent_viscosity")[0], mean_se(sf, "apparent_viscosity")[0]
+    return [f"From {rc.mesh} to {rf.mesh}: " + "; ".join(parts) + ". Against Pries' in-vitro law at each run's "
+            f"own H_D, eta_app goes from {(ec - law_c) / law_c:+.1%} to {(ef - law_f) / law_f:+.1%}. A change "
+            "within about two standard errors is one these runs cannot tell from noise; a larger one means the "
+            f"figure has not converged at {rc.mesh}.", ""]
+
+
 def net_force_removed_section(work, all_parts, table_of):
     """The methods runs beside their twins without the bending force's net force and torque: each
     twin against its plain run and against Method A, in standard errors."""
@@ -659,11 +684,16 @@ def write_doc(argv, work, doc, all_parts, binary_commit=None, bendlab=None):
     L += ["## Hematocrit", ""]
     L += table("hematocrit", "H_T target", lambda r: fmt_g(r.hematocrit))
     L += ["## Resolution", "", "The D = 10 um, H_T = 0.3, Method C case with cells of 1280 and 5120 triangles:", ""]
-    L += table("resolution", "mesh", lambda r: r.mesh)
+    # The D = 10 um, H_T 0.3, Method C run of the methods part: the first row of the resolution and
+    # sensitivity tables.
+    base = all_parts["methods"][0] if all_parts["methods"] and all_parts["methods"][0].method == "C" else None
+    res = dict(all_parts)
+    res["resolution"] = ([base] if base else []) + all_parts["resolution"]
+    L += table_of(res, "resolution", "mesh", lambda r: r.mesh)
+    L += resolution_verdict(work, res["resolution"])
     L += ["## Sensitivity", "",
           "The D = 10 um, H_T = 0.3, Method C case (first row) with the repulsion's cutoff halved to 0.25 um "
           "(from one dx), and with the periodic length three diameters instead of two:", ""]
-    base = all_parts["methods"][0] if all_parts["methods"] and all_parts["methods"][0].method == "C" else None
     sens = dict(all_parts)
     sens["sensitivity"] = ([base] if base else []) + all_parts["sensitivity"]
     L += table_of(sens, "sensitivity", "variant",
