@@ -469,6 +469,7 @@ def departure_evidence(work, all_parts):
     L = ["What the finished runs say about the candidates (each against the D = 10 um, H_T 0.3, Method C "
          f"run, eta_app {num(e0)} ± {num(se0, 2)}, {(e0 - law0) / law0:+.1%} from the law):", ""]
     variants = [(run(10, 0.3, "none"), "without bending (no bending force, so no net force of one)"),
+                (run(10, 0.3, "C", net_force="remove"), "Method C with its bending force's net force and torque removed"),
                 (run(10, 0.3, contact_cutoff=0.25), "the repulsion's cutoff halved to 0.25 um"),
                 (run(10, 0.3, length_factor=3.0), "a periodic length of three diameters"),
                 (run(10, 0.3, "C", "mt1:5120"), "cells of 5120 triangles")]
