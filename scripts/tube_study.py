@@ -176,6 +176,23 @@ def done(r, work):
     return s if s is not None and study_runner.matches(s, r.key()) else None
 
 
+def unfinished(r, work):
+    """What a run without a summary reached, from the last progress line of its run.log ("t = T /
+    T_END s ... elapsed S s"): how far it got and the wall time that took; "not run yet" without one."""
+    import re
+    try:
+        lines = (work / r.name / "run.log").read_text().splitlines()
+    except OSError:
+        return "not run yet"
+    for line in reversed(lines):
+        m = re.match(r"t = ([0-9.eE+-]+) / ([0-9.eE+-]+) s .*elapsed ([0-9.]+) s", line)
+        if m:
+            t, t_end, wall = (float(v) for v in m.groups())
+            return (f"unfinished: t = {num(t, 3)} s of {num(t_end, 3)} s reached in {wall:.0f} s of wall time (about "
+                    f"{wall * t_end / t / 3600:.1f} h for the whole run at that rate)")
+    return "not run yet"
+
+
 def failure(r, work):
     """The run's error as the document shows it (without the program's prefix and the checkpoint's
     path), or None where it did not fail."""
@@ -621,7 +638,7 @@ def write_doc(argv, work, doc, all_parts, binary_commit=None, bendlab=None):
             s = done(r, work)
             if s is None:
                 err = failure(r, work)
-                rows.append(f"| {cell(r)} | " + (f"failed: {err}" if err else "not run yet") + " |" + " |" * 9)
+                rows.append(f"| {cell(r)} | " + (f"failed: {err}" if err else unfinished(r, work)) + " |" + " |" * 9)
                 continue
             hd, _ = mean_se(s, "discharge_hematocrit")
             ht, _ = mean_se(s, "tube_hematocrit")

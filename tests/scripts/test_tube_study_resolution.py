@@ -35,3 +35,19 @@ def test_resolution_verdict(tmp_path):
     assert f"the cell-free layer 1.3 -> 1.2 ({-0.1 / 1.3:+.1%}, {-0.1 / math.hypot(0.01, 0.01):+.1f} standard" in text
     law = tube_study.pries_in_vitro(10, 0.38)
     assert f"from {(1.5 - law) / law:+.1%} to {(1.54 - law) / law:+.1%}" in text
+
+
+def test_unfinished_run_reports_how_far_it_got(tmp_path):
+    run = tube_study.run(20, 0.3)
+    assert tube_study.unfinished(run, tmp_path) == "not run yet"
+    folder = tmp_path / run.name
+    folder.mkdir()
+    (folder / "run.log").write_text("$ bendlab flow ...\nplaced 40 cells\n")
+    assert tube_study.unfinished(run, tmp_path) == "not run yet"  # started, no progress line
+    (folder / "run.log").write_text(
+        "$ bendlab flow ...\n"
+        "t = 0.01 / 0.1 s ( 10%)  eta_app 1.9  H_D 0.35  CFL_um 1.0  elapsed 1800 s  ETA 16200 s  5.3 MLUPS\n"
+        "t = 0.02 / 0.1 s ( 20%)  eta_app 1.97  H_D 0.35  CFL_um 1.1  elapsed 3600 s  ETA 14400 s  5.3 MLUPS\n")
+    # The last line: 3600 s for a fifth of the run, so 5 h for all of it.
+    assert tube_study.unfinished(run, tmp_path) == (
+        "unfinished: t = 0.02 s of 0.1 s reached in 3600 s of wall time (about 5.0 h for the whole run at that rate)")
