@@ -26,6 +26,7 @@ import json
 import math
 import os
 import platform
+import re
 import shlex
 import shutil
 import signal
@@ -367,7 +368,7 @@ class Runner:
         out/run.log (after a line `$ command`); returns (exit status, last line of the log when
         it failed). Raises Stopped when the study is being stopped."""
         with open(Path(out) / "run.log", "a") as log:
-            log.write("$ " + shlex.join(cmd) + "\n")
+            log.write("$ " + launch_environment() + shlex.join(cmd) + "\n")
             log.flush()
             with self._live_lock:
                 if self._stopping.is_set():
@@ -506,18 +507,46 @@ def machine():
     return f"{cores()} cores (nproc){', ' + cpu if cpu else ''}, {platform.system()} {platform.machine()}"
 
 
-def binary_of(folder):
-    """The program that made a run: the first word of its run.log's latest `$ command` line (the
-    line launch() writes before each start), or None."""
+def launch_environment():
+    """What of the environment a run's time depends on, as the `$ command` line of run.log names it
+    (`OMP_NUM_THREADS=N `, or nothing where it is not set)."""
+    threads = os.environ.get("OMP_NUM_THREADS")
+    return f"OMP_NUM_THREADS={shlex.quote(threads)} " if threads else ""
+
+
+def launch_lines(folder):
+    """The words of each `$ command` line of a run's run.log (launch() writes one before each start
+    or resume), the environment assignments first, oldest first; [] without a log."""
     try:
         lines = (Path(folder) / "run.log").read_text(errors="replace").splitlines()
     except OSError:
-        return None
-    for line in reversed(lines):
-        if line.startswith("$ "):
-            words = shlex.split(line[2:])
-            return words[0] if words else None
+        return []
+    return [shlex.split(line[2:]) for line in lines if line.startswith("$ ")]
+
+
+def split_environment(words):
+    """A `$ command` line's words as (its leading VAR=value assignments as a dict, the rest)."""
+    env = {}
+    while words and re.match(r"^[A-Za-z_][A-Za-z0-9_]*=", words[0]):
+        name, value = words[0].split("=", 1)
+        env[name] = value
+        words = words[1:]
+    return env, words
+
+
+def binary_of(folder):
+    """The program that made a run: the first word after the environment of its run.log's latest
+    `$ command` line, or None."""
+    for words in reversed(launch_lines(folder)):
+        rest = split_environment(words)[1]
+        return rest[0] if rest else None
     return None
+
+
+def threads_of(folder):
+    """The OMP_NUM_THREADS each start of a run named on its `$ command` line, oldest first (None for
+    a start whose line names none: lines written before it was recorded)."""
+    return [split_environment(words)[0].get("OMP_NUM_THREADS") for words in launch_lines(folder)]
 
 
 def generated_by(command_line):

@@ -193,6 +193,13 @@ def unfinished(r, work):
     return "not run yet"
 
 
+def threads_note(work, r):
+    """" on N threads" where a start of the run names OMP_NUM_THREADS other than 1 on its run.log's
+    launch line (the largest such N), else "" (the study's command sets 1)."""
+    counts = [int(c) for c in study_runner.threads_of(work / r.name) if c and c.isdigit() and int(c) != 1]
+    return f" on {max(counts)} threads" if counts else ""
+
+
 def failure(r, work):
     """The run's error as the document shows it (without the program's prefix and the checkpoint's
     path), or None where it did not fail."""
@@ -649,7 +656,7 @@ def write_doc(argv, work, doc, all_parts, binary_commit=None, bendlab=None):
                         f"{pm(s, 'apparent_viscosity')} | {num(pries_in_vitro(D, hd) if hd else None)} | "
                         f"{num(ht / hd if hd else None, 3)} | {num(fahraeus(D, hd) if hd else None, 3)} | "
                         f"{pm(s, 'cell_free_layer_um', 3)} | {num(shape_D, 3)} | {num(angle, 3)} | "
-                        f"{s['wall_seconds']:.0f} s |")
+                        f"{s['wall_seconds']:.0f} s{threads_note(work, r)} |")
         return rows + [""]
 
     L += ["## The bending algorithm in a suspension", "",
@@ -776,8 +783,12 @@ def write_doc(argv, work, doc, all_parts, binary_commit=None, bendlab=None):
     binaries = {}
     for r, _ in have:
         binaries.setdefault(study_runner.binary_of(work / r.name) or "unknown", []).append(r.name)
-    L += ["## Run time", "", f"The runs shown took {total:.0f} s of wall time together (one thread each, on a "
-          "machine shared with other work). The programs that made them, as each run.log's command names it: "
+    several = [(r.name, study_runner.threads_of(work / r.name)) for r, _ in have if threads_note(work, r)]
+    L += ["## Run time", "", f"The runs shown took {total:.0f} s of wall time together (one thread each, as the "
+          "study's command sets OMP_NUM_THREADS=1" + ("; except " + "; ".join(
+              f"{name}, whose starts ran on " + ", ".join(c or "unrecorded" for c in counts) + " threads (its run.log's "
+              "launch lines)" for name, counts in several) if several else "") + "; on a machine shared with other "
+          "work). The programs that made them, as each run.log's command names it: "
           + "; ".join(f"`{Path(b).name}` ({', '.join(names)})" for b, names in sorted(binaries.items())) + ".", ""]
     L += ["## Commands", "", "Each run shown, as the script starts it (`--resume` continues one):", "", "```"]
     for r, s in have:

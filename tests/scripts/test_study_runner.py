@@ -368,3 +368,17 @@ def test_the_program_of_a_run_is_the_first_word_of_its_latest_command_line(tmp_p
     (tmp_path / "run.log").write_text("$ /tmp/old/bendlab shear --out x\nstep 1\n$ '/tmp/new dir/bendlab' shear --resume\nstep 2\n")
     assert sr.binary_of(tmp_path) == "/tmp/new dir/bendlab"
     assert sr.binary_of(tmp_path / "none") is None
+
+
+def test_the_launch_line_names_the_thread_count_and_the_program_after_it(tmp_path, monkeypatch):
+    monkeypatch.setenv("OMP_NUM_THREADS", "2")
+    assert sr.launch_environment() == "OMP_NUM_THREADS=2 "
+    monkeypatch.delenv("OMP_NUM_THREADS")
+    assert sr.launch_environment() == ""
+    (tmp_path / "run.log").write_text("$ /tmp/a/bendlab flow --out x\nt = 1\n"
+                                      "$ OMP_NUM_THREADS=2 '/tmp/b dir/bendlab' flow --resume\nt = 2\n")
+    assert sr.binary_of(tmp_path) == "/tmp/b dir/bendlab"
+    assert sr.threads_of(tmp_path) == [None, "2"]
+    assert sr.threads_of(tmp_path / "none") == []
+    # Only the leading assignments are the environment: a later word with '=' is the program's.
+    assert sr.split_environment(["A=1", "B_2=x", "prog", "C=3"]) == ({"A": "1", "B_2": "x"}, ["prog", "C=3"])

@@ -51,3 +51,15 @@ def test_unfinished_run_reports_how_far_it_got(tmp_path):
     # The last line: 3600 s for a fifth of the run, so 5 h for all of it.
     assert tube_study.unfinished(run, tmp_path) == (
         "unfinished: t = 0.02 s of 0.1 s reached in 3600 s of wall time (about 5.0 h for the whole run at that rate)")
+
+
+def test_threads_note_names_a_count_other_than_one(tmp_path):
+    run = tube_study.run(10, 0.3, "C", "mt1:5120")
+    assert tube_study.threads_note(tmp_path, run) == ""  # no log: the study's one thread
+    folder = tmp_path / run.name
+    folder.mkdir()
+    (folder / "run.log").write_text("$ /tmp/bendlab flow --out x\nt = 1\n$ OMP_NUM_THREADS=1 /tmp/bendlab flow --resume\n")
+    assert tube_study.threads_note(tmp_path, run) == ""
+    with open(folder / "run.log", "a") as log:
+        log.write("$ OMP_NUM_THREADS=2 /tmp/bendlab flow --resume\n")
+    assert tube_study.threads_note(tmp_path, run) == " on 2 threads"
