@@ -389,14 +389,7 @@ class Runner:
         with self._live_lock:
             dirs = sorted(out for _, out in self._live)
         for d in dirs:
-            last = ""
-            try:
-                for line in (d / "run.log").read_text().splitlines():
-                    # shear's progress lines start "gamma t =", flow's and the others' "t ="
-                    if line.startswith(("gamma t =", "t =")):
-                        last = line
-            except OSError:
-                pass
+            last = last_progress_line(d)
             self.say(f"  [{elapsed / 60:5.1f} min] {d.name}: {' '.join(last.split()) or 'starting'}")
 
     def stop(self):
@@ -522,6 +515,16 @@ def launch_lines(folder):
     except OSError:
         return []
     return [shlex.split(line[2:]) for line in lines if line.startswith("$ ")]
+
+
+def last_progress_line(folder):
+    """The latest progress line of a run's run.log ("" without one): shear's start "gamma t =",
+    flow's and the others' "t ="."""
+    try:
+        lines = (Path(folder) / "run.log").read_text(errors="replace").splitlines()
+    except OSError:
+        return ""
+    return next((line for line in reversed(lines) if line.startswith(("gamma t =", "t ="))), "")
 
 
 def split_environment(words):

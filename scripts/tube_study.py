@@ -180,17 +180,13 @@ def unfinished(r, work):
     """What a run without a summary reached, from the last progress line of its run.log ("t = T /
     T_END s ... elapsed S s"): how far it got and the wall time that took; "not run yet" without one."""
     import re
-    try:
-        lines = (work / r.name / "run.log").read_text().splitlines()
-    except OSError:
+    m = re.match(r"t = ([0-9.eE+-]+) / ([0-9.eE+-]+) s .*elapsed ([0-9.]+) s",
+                 study_runner.last_progress_line(work / r.name))
+    if not m:
         return "not run yet"
-    for line in reversed(lines):
-        m = re.match(r"t = ([0-9.eE+-]+) / ([0-9.eE+-]+) s .*elapsed ([0-9.]+) s", line)
-        if m:
-            t, t_end, wall = (float(v) for v in m.groups())
-            return (f"unfinished: t = {num(t, 3)} s of {num(t_end, 3)} s reached in {wall:.0f} s of wall time (about "
-                    f"{wall * t_end / t / 3600:.1f} h for the whole run at that rate)")
-    return "not run yet"
+    t, t_end, wall = (float(v) for v in m.groups())
+    return (f"unfinished: t = {num(t, 3)} s of {num(t_end, 3)} s reached in {wall:.0f} s of wall time (about "
+            f"{wall * t_end / t / 3600:.1f} h for the whole run at that rate)")
 
 
 def threads_note(work, r):
@@ -430,9 +426,11 @@ def answer(bendlab, work, runs, without_net_force=()):
     exact = [m for m in ran_methods if worst.get(m, 1.0) < 1e-9]
     unfit = sorted({r.method for r, _ in failed})
     usable = [m for m in ran_methods if m not in exact and m not in unfit]
-    L[-1] += without_net_force_answer(work, eta, without_net_force)
+    clean = {r.method: mean_se(s, "apparent_viscosity") for r in without_net_force
+             if r.method in eta and (s := done(r, work)) is not None}
+    L[-1] += without_net_force_answer(eta, clean)
     pick = []
-    removed = sorted(r.method for r in without_net_force if done(r, work) is not None and r.method in eta)
+    removed = sorted(clean)
     if len(removed) >= 2:
         pick.append(f"Method {' or '.join(removed)} with its net force removed (`--bending-net-force remove`): "
                     "they then come together, as above")
@@ -455,11 +453,10 @@ def answer(bendlab, work, runs, without_net_force=()):
     return L + [""]
 
 
-def without_net_force_answer(work, eta, runs):
-    """What removing the bending force's net force does to the methods' spread of eta_app (eta: the
-    plain runs' (mean, standard error) per method), or "" while fewer than two of those runs are done."""
-    clean = {r.method: mean_se(s, "apparent_viscosity") for r in runs if (s := done(r, work)) is not None}
-    clean = {m: v for m, v in clean.items() if m in eta}
+def without_net_force_answer(eta, clean):
+    """What removing the bending force's net force does to the methods' spread of eta_app (eta, clean:
+    (mean, standard error) per method of the plain runs and of those without the net force), or ""
+    while fewer than two of the latter are done."""
     if len(clean) < 2:
         return ""
     lo, hi = min(clean, key=lambda m: clean[m][0]), max(clean, key=lambda m: clean[m][0])
@@ -472,9 +469,8 @@ def without_net_force_answer(work, eta, runs):
     if "none" in eta:
         off = max(abs(v[0] - eta["none"][0]) for v in clean.values())
         text += f", and within {off:.2g} of the run without bending"
-    if "A" in eta:
-        text += f" (Method A, whose force has no net force to remove: {eta['A'][0] - eta['none'][0]:+.3g} from it)" \
-            if "none" in eta else ""
+        if "A" in eta:
+            text += f" (Method A, whose force has no net force to remove: {eta['A'][0] - eta['none'][0]:+.3g} from it)"
     text += (f". Most of what separated Methods {lo} and {hi} in a suspension was the net force their "
              f"discretisation leaves on a cell, not their bending; `flow --bending-net-force remove` takes it off.")
     return text
