@@ -275,7 +275,8 @@ void MpiSuspension::spread_and_step(std::int64_t n) {
   // exchanges below stay matched.
   const int m = static_cast<int>(std::ceil(lbm::ib_kernel_half_width(options_.kernel)));
   per_row_ = 8 * m * m * m;  // (2 m)^3
-  std::vector<Eigen::Index> held_rows;  // global row of each held row, in held order
+  std::vector<Eigen::Index>& held_rows = held_rows_;
+  held_rows.clear();
   for (int c : held_)
     for (Eigen::Index k = first_row(c); k < first_row(c) + rows(c); ++k) held_rows.push_back(k);
   const std::size_t entries = held_rows.size() * static_cast<std::size_t>(per_row_);

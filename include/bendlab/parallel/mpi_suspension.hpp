@@ -135,6 +135,7 @@ class MpiSuspension {
   // The stencils of the held cells' rows, in held order, per_row_ entries each (zero weights
   // kept): 20 bytes an entry, where an lbm::IbStencil is 1 kB a row whatever the kernel.
   int per_row_ = 0;
+  std::vector<Eigen::Index> held_rows_;      // the global row of each held row, in held order
   std::vector<double> entry_weight_;
   std::vector<int> entry_owner_;             // the rank owning the entry node's layer
   std::vector<std::size_t> entry_local_;     // its local node where that rank is this one
