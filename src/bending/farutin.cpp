@@ -181,8 +181,8 @@ double farutin_laplacian_point(const FarutinFit& fit, const Vec3& x0, std::span<
 
 // One thread's buffers: its neighbourhood (for one topology) and the values of a field on it.
 struct FarutinWorkspace::Thread {
-  explicit Thread(const Topology& t) : topology(&t), nb(t) {}
-  const Topology* topology;
+  explicit Thread(const Topology& t) : topology_id(t.id()), nb(t) {}
+  std::uint64_t topology_id;  // Topology::id(): the address may be a later topology's
   Neighbourhood nb;
   std::vector<double> values;
 };
@@ -197,7 +197,7 @@ void FarutinWorkspace::prepare() {
 
 FarutinWorkspace::Thread& FarutinWorkspace::thread(int k, const Topology& topology) {
   std::unique_ptr<Thread>& slot = threads_[k];
-  if (!slot || slot->topology != &topology) slot = std::make_unique<Thread>(topology);
+  if (!slot || slot->topology_id != topology.id()) slot = std::make_unique<Thread>(topology);
   return *slot;
 }
 

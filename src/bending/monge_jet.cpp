@@ -337,8 +337,8 @@ std::vector<MongeJetFit> monge_jet_fit(const Topology& t, const Points& x, const
 
 // One thread's buffers: its neighbourhood (for one topology), the supports of a batch of nodes.
 struct MongeJetWorkspace::Thread {
-  explicit Thread(const Topology& t) : topology(&t), nb(t) {}
-  const Topology* topology;
+  explicit Thread(const Topology& t) : topology_id(t.id()), nb(t) {}
+  std::uint64_t topology_id;  // Topology::id(): the address may be a later topology's
   VertexRings nb;
   std::vector<Vec3> buffer;
   std::array<std::vector<Vec3>, kJetLanes> supports;
@@ -355,7 +355,7 @@ void MongeJetWorkspace::prepare() {
 
 MongeJetWorkspace::Thread& MongeJetWorkspace::thread(int k, const Topology& topology) {
   std::unique_ptr<Thread>& slot = threads_[k];
-  if (!slot || slot->topology != &topology) slot = std::make_unique<Thread>(topology);
+  if (!slot || slot->topology_id != topology.id()) slot = std::make_unique<Thread>(topology);
   return *slot;
 }
 

@@ -12,6 +12,8 @@
 //   counter-clockwise order about the outward normal; ring_faces()[k] is the face (i, j_k, j_{k+1})
 //   (indices mod d), ring_edges()[k] the edge (i, j_k), ring_corners()[k] the corner (0..2) of i
 //   in ring_faces()[k]. So the faces around a vertex are the same CSR slice.
+#include <atomic>
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -49,8 +51,30 @@ class Topology {
   /// Euler characteristic V - E + F (2 for a sphere).
   int euler_characteristic() const { return num_vertices() - num_edges() + num_faces(); }
 
+  /// A number no other Topology object of this process has had, a copy included. Buffers kept
+  /// for one connectivity (a method's per-thread workspace) are keyed on it, not on the object's
+  /// address: a topology freed and another built may share an address (the allocator reuses the
+  /// block), and a buffer sized for the first would then be indexed by the second's vertices.
+  std::uint64_t id() const { return id_.value; }
+
  private:
+  // A fresh number for every object, also for a copy or an assignment.
+  struct Identity {
+    static std::uint64_t next() {
+      static std::atomic<std::uint64_t> counter{0};
+      return ++counter;
+    }
+    Identity() : value(next()) {}
+    Identity(const Identity&) : value(next()) {}
+    Identity& operator=(const Identity&) {
+      value = next();
+      return *this;
+    }
+    std::uint64_t value;
+  };
+
   Topology() = default;
+  Identity id_;
   int num_vertices_ = 0;
   Faces faces_;
   IndexPairs edge_vertices_, edge_faces_, edge_opposite_;
