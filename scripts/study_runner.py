@@ -136,7 +136,12 @@ def read_series(folder, columns=None):
         return None
     if not rows:
         return None
-    return {k: np.array([float(r[k]) for r in rows]) for k in (columns or rows[0].keys())}
+    return {k: np.array([number(r[k]) for r in rows]) for k in (columns or rows[0].keys())}
+
+
+def number(field):
+    """A field of bendlab's CSV files: an empty one is an undefined value (NaN)."""
+    return float(field) if field != "" else float("nan")
 
 
 def finished(folder, run):

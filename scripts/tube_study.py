@@ -235,7 +235,7 @@ def read_csv(path):
             rows = list(csv.DictReader(f))
     except OSError:
         return None
-    return {k: np.array([float(r[k]) for r in rows]) for k in rows[0]} if rows else None
+    return {k: np.array([study_runner.number(r[k]) for r in rows]) for k in rows[0]} if rows else None
 
 
 def cell_shapes(work, r, s):

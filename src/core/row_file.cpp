@@ -27,11 +27,10 @@ std::size_t columns_of(const std::string& header) {
 // One number as the writer writes it: strtod's whole field, overflow refused, underflow kept
 // (a subnormal is a number the writer wrote).
 bool parse_number(const std::string& field, double& value) {
-  if (field == "nan") {
+  if (field.empty() || field == "nan") {  // undefined (files of older versions wrote "nan")
     value = std::numeric_limits<double>::quiet_NaN();
     return true;
   }
-  if (field.empty()) return false;
   char* end = nullptr;
   errno = 0;
   value = std::strtod(field.c_str(), &end);
@@ -107,10 +106,14 @@ void RowFile::append(const NumberRow& values) {
   if (values.size() != columns_)
     throw Error(fmt::format("'{}': a row of {} values, the header has {} columns", path_.string(), values.size(),
                             columns_));
+  for (std::size_t k = 0; k < values.size(); ++k)
+    if (std::isinf(values[k]))
+      throw Error(fmt::format("'{}': column {} of row {} is {}, not a number a result file can hold", path_.string(),
+                              k + 1, rows_ + 1, values[k]));
   std::string line;
   for (std::size_t k = 0; k < values.size(); ++k) {
     if (k) line += ',';
-    line += std::isnan(values[k]) ? std::string("nan") : fmt::format("{:.12g}", values[k]);
+    if (!std::isnan(values[k])) line += fmt::format("{:.12g}", values[k]);  // undefined: an empty field
   }
   line += '\n';
   out_ << line;

@@ -324,11 +324,13 @@ nlohmann::json SuspensionRecorder::summary(const fs::path& folder, double t_end,
              << ",velocity_um_s,hematocrit,lines\n";
   const double dx = solver_.options().dx_um;
   const double z0 = options_.vessel_um.kind() == VesselKind::Tube ? 0.0 : -0.5 * options_.vessel_um.height();
+  // A bin without samples (no line of it in the section, or no report in the window) has no mean:
+  // an empty field, as RowFile writes an undefined value.
+  auto mean = [](double sum, double n) { return n > 0 ? fmt::format("{:.12g}", sum / n) : std::string(); };
   for (std::size_t b = 0; b < bin_lines_.size(); ++b) {
     const double n = bin_lines_[b] * static_cast<double>(profile_samples_);
-    f.stream() << fmt::format("{:.12g},{:.12g},{:.12g},{}\n", z0 + (static_cast<double>(b) + 0.5) * dx,
-                              n > 0 ? velocity_sum_[b] / n : kNaN, n > 0 ? hematocrit_sum_[b] / n : kNaN,
-                              bin_lines_[b]);
+    f.stream() << fmt::format("{:.12g},{},{},{}\n", z0 + (static_cast<double>(b) + 0.5) * dx,
+                              mean(velocity_sum_[b], n), mean(hematocrit_sum_[b], n), bin_lines_[b]);
   }
   f.commit();
   return fields;

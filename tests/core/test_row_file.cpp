@@ -1,5 +1,6 @@
-// RowFile: what the writer writes the reader reads (subnormal, nan, inf included); a resume keeps
-// the first rows byte for byte and drops a half-written one.
+// RowFile: what the writer writes the reader reads (subnormal and undefined values included), no
+// result file holds a non-finite number; a resume keeps the first rows byte for byte and drops a
+// half-written one.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -26,17 +27,34 @@ TEST(RowFile, ReadsBackWhatItWrites) {
   RowFile f = RowFile::create(p, "a,b,c");
   const double sub = 1.23301775164e-314;  // subnormal: std::stod would refuse it (ERANGE)
   f.append({1.0 / 3.0, -2.5e-300, sub});
-  f.append({std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity(),
-            -std::numeric_limits<double>::infinity()});
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  f.append({nan, 2.0, nan});
+  // Infinity is refused, and the refused row leaves nothing in the file.
+  EXPECT_THROW(f.append({1.0, inf, 3.0}), Error);
+  EXPECT_THROW(f.append({-inf, 2.0, 3.0}), Error);
   const std::vector<NumberRow> rows = RowFile::read_all(p, "a,b,c");
   ASSERT_EQ(rows.size(), 2u);
   EXPECT_NEAR(rows[0][0], 1.0 / 3.0, 1e-12);
   EXPECT_NEAR(rows[0][1], -2.5e-300, 1e-311);
   EXPECT_EQ(rows[0][2], sub);  // 12 digits are all a subnormal this small holds
+  // An undefined value is an empty field, read back as NaN; no "nan" or "inf" in the file.
   EXPECT_TRUE(std::isnan(rows[1][0]));
-  EXPECT_EQ(rows[1][1], std::numeric_limits<double>::infinity());
-  EXPECT_EQ(rows[1][2], -std::numeric_limits<double>::infinity());
+  EXPECT_EQ(rows[1][1], 2.0);
+  EXPECT_TRUE(std::isnan(rows[1][2]));
+  const std::string text = slurp(p);
+  EXPECT_NE(text.find("\n,2,\n"), std::string::npos) << text;
+  EXPECT_EQ(text.find("nan"), std::string::npos) << text;
+  EXPECT_EQ(text.find("inf"), std::string::npos) << text;
   EXPECT_THROW(f.append({1.0, 2.0}), Error);
+  fs::remove(p);
+}
+
+TEST(RowFile, ReadsTheNanOfOlderFilesAsUndefined) {
+  const fs::path p = temp("older.csv");
+  std::ofstream(p) << "a,b\nnan,1\n";
+  const std::vector<NumberRow> rows = RowFile::read_all(p, "a,b");
+  ASSERT_EQ(rows.size(), 1u);
+  EXPECT_TRUE(std::isnan(rows[0][0]));
   fs::remove(p);
 }
 

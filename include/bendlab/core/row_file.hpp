@@ -1,8 +1,10 @@
 #pragma once
 // A CSV file of numeric rows that a run appends to, one row per record, and a resume cuts back to
 // the rows of its checkpoint: a header line, then rows of numbers written with 12 significant
-// digits ("{:.12g}"; `nan`, `inf` and `-inf` as such). The reader takes whatever the writer
-// writes, subnormal numbers included.
+// digits ("{:.12g}"), an undefined value (NaN: no cells, no cell-free layer) as an empty field,
+// and no infinity (append refuses it): no result file holds a non-finite number. The reader takes
+// whatever the writer writes, subnormal numbers included, and an empty field or "nan" (files of
+// older versions) as NaN.
 //
 // Appends are flushed and checked (a failed write throws bendlab::Error naming the file); the
 // cut of a resume rewrites the file through a temporary and an atomic rename, so it is never
@@ -26,7 +28,7 @@ class RowFile {
   static RowFile resume(const std::filesystem::path& path, const std::string& header, std::int64_t rows);
 
   /// Appends a row of the header's column count and flushes; throws bendlab::Error for another
-  /// count or a failed write.
+  /// count, an infinite value or a failed write (NaN is written as an empty field).
   void append(const NumberRow& values);
   std::int64_t rows() const { return rows_; }
   const std::filesystem::path& path() const { return path_; }
