@@ -62,7 +62,7 @@ void flow(FlowArgs& a) {
   s.contact_force = a.contact_force_pn * 1e-12;
   s.cell.method_options = a.options;
   s.cell.bending_without_net_force = a.bending_net_force == "remove";
-  if (!(a.t_end > 0) || !std::isfinite(a.t_end)) throw Error(fmt::format("--t-end {} s must be positive", a.t_end));
+  FlowRun::check_end(s, a.t_end);
 
   // Under mpirun: the fluid in y-slabs and each cell owned by one rank; rank 0 writes the run
   // folder (docs/mpi.md, "Many cells").

@@ -61,6 +61,7 @@ void bind_flow(py::module_& m) {
         s.sample_every = sample_every;
         s.steady_from = steady_from;
         s.slice_width_um = slice_width;
+        FlowRun::check_end(s, t_end);  // before the relaxation
 
         RunHooks hooks(progress);
         CapsuleRunOptions o;

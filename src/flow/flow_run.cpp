@@ -73,6 +73,17 @@ FlowRun::FlowRun(const FlowRunSpec& spec, const std::function<void(const std::st
   auto say = [&](const std::string& s) {
     if (note) note(s);
   };
+  units_.checked_steps(spec_.sample_every, "--sample-every", true);
+  // The cell-free flow (tubes and channels) is relaxed on the lattice before the run. It
+  // develops over about (section / dx)^2 / nu_lattice steps: a lattice viscosity near 0 (tau near
+  // 1/2) would take longer than any run should, refused here before the relaxation runs for
+  // nothing (and checked again below where it did not settle).
+  const double develop_steps = units_.section_lattice * units_.section_lattice / units_.nu_lattice;
+  if (spec_.units.geometry != lbm::FlowGeometry::Shear && develop_steps > 10.0 * kMaxRelaxSteps)
+    throw Error(fmt::format("--tau {}: the lattice viscosity (tau - 1/2)/3 = {:.3g} needs about {:.3g} lattice steps to "
+                            "develop the cell-free flow across {:.4g} dx, far beyond the {} its relaxation may take: "
+                            "raise --tau",
+                            spec_.units.tau, units_.nu_lattice, develop_steps, units_.section_lattice, kMaxRelaxSteps));
   const double dx = spec_.units.dx_um;
   const bool shear = spec_.units.geometry == lbm::FlowGeometry::Shear;
   vessel_um_ = vessel_of(spec_.units, 1.0);
@@ -168,17 +179,27 @@ FlowRun::FlowRun(const FlowRunSpec& spec, const std::function<void(const std::st
       });
   double q = lattice_flow_rate(lattice, dx, units_.dt);
   constexpr std::int64_t kBlock = 100;
-  while (relax_steps_ < kMaxRelaxSteps) {
+  constexpr double kSettled = 1e-9;  // relative change of Q over one block
+  bool settled = false;
+  double change = 0;
+  while (relax_steps_ < kMaxRelaxSteps && !settled) {
     lattice.run(kBlock);
     relax_steps_ += kBlock;
     const double next = lattice_flow_rate(lattice, dx, units_.dt);
-    const bool settled = std::abs(next - q) <= 1e-9 * std::abs(next);
+    change = std::abs(next - q) / std::abs(next);
+    settled = change <= kSettled;
     q = next;
-    if (settled) break;
   }
   if (!(q > 0) || !std::isfinite(q))
     throw Error(fmt::format("the cell-free flow's rate is {} after {} steps: the lattice cannot carry this flow", q,
                             relax_steps_));
+  // Unsettled, Q0 would not be the flow the cells start in.
+  if (!settled)
+    throw Error(fmt::format("--tau {}: the cell-free flow did not settle in {} lattice steps (its rate still changes "
+                            "by {:.2g} per {} steps, {:.2g} allowed); the lattice viscosity (tau - 1/2)/3 = {:.3g} "
+                            "needs about {:.3g} steps to develop the flow across {:.4g} dx: raise --tau",
+                            spec_.units.tau, relax_steps_, change, kBlock, kSettled, units_.nu_lattice,
+                            develop_steps, units_.section_lattice));
   q0_ = q;
   say(fmt::format("cell-free flow relaxed in {} steps: Q0 = {:.6g} um^3/s (mean velocity {:.4g} um/s, analytic {:.4g})",
                   relax_steps_, q0_, q0_ / (vessel_um_.volume() / vessel_um_.length()), units_.mean_velocity * 1e6));
@@ -221,7 +242,13 @@ std::vector<std::string> FlowRun::describe() const {
 
 std::optional<std::string> FlowRun::warning() const { return mesh_leak_warning(kind_, spec_.units.dx_um); }
 
+void FlowRun::check_end(const FlowRunSpec& spec, double t_end) {
+  if (!(t_end > 0) || !std::isfinite(t_end)) throw Error(fmt::format("--t-end {} s must be positive", t_end));
+  lbm::flow_units(spec.units).checked_steps(t_end, "--t-end");
+}
+
 CapsuleRunResult FlowRun::run(CapsuleRunOptions options) {
+  check_end(spec_, options.t_end);
   nlohmann::json arguments = spec_.to_json();
   for (const auto& [key, value] : options.arguments.items()) arguments[key] = value;
   options.arguments = arguments;

@@ -36,7 +36,26 @@ TEST(FlowUnits, TimeStepFollowsFromTauAndTheViscosity) {
   EXPECT_EQ(u.ny, 54);  // 50 dx and two solid layers on either side
   EXPECT_EQ(u.nz, 54);
   EXPECT_DOUBLE_EQ(u.section_lattice, 50);
-  EXPECT_NEAR(u.steps_for(1e-3), 1e4, 0);
+  EXPECT_NEAR(u.checked_steps(1e-3, "--t-end"), 1e4, 0);
+}
+
+TEST(FlowUnits, StepCountsARunCannotTakeAreRefusedNamingTheOption) {
+  const FlowUnits u = flow_units(tube(10, 20, 0.5, 1.0, 100));
+  // Rounded up: a run steps to the first step at or past its end.
+  EXPECT_EQ(u.checked_steps(2.5 * u.dt, "--t-end"), 3);
+  auto message = [&](double seconds, const char* option, bool below_one_ok) {
+    try {
+      u.checked_steps(seconds, option, below_one_ok);
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(message(1e30, "--t-end", false).find("--t-end 1e+30 s is"), std::string::npos);
+  EXPECT_NE(message(FlowUnits::kMaxSteps * 2 * u.dt, "--sample-every", true).find("--sample-every"), std::string::npos);
+  EXPECT_NE(message(1e-320, "--t-end", false).find("shorter than one lattice step"), std::string::npos);
+  EXPECT_EQ(message(1e-320, "--sample-every", true), "");  // a report every step
+  EXPECT_EQ(message(FlowUnits::kMaxSteps * u.dt * 0.5, "--t-end", false), "");
 }
 
 TEST(FlowUnits, DrivingsArePoiseuillesLawBothWays) {

@@ -67,6 +67,11 @@ class FlowRun {
   FlowRun(const FlowRunSpec& spec, const std::function<void(const std::string&)>& note = nullptr,
           const SuspensionSolverFactory& make_solver = nullptr);
 
+  /// Throws bendlab::Error naming --t-end where a run of `spec` to `t_end` would take less than
+  /// one lattice step or more than a run can count (lbm::FlowUnits::checked_steps). Cheap: call it
+  /// before the constructor's relaxation. run() checks it again.
+  static void check_end(const FlowRunSpec& spec, double t_end);
+
   const FlowRunSpec& spec() const { return spec_; }
   const lbm::FlowUnits& units() const { return units_; }
   const CellKind& kind() const { return kind_; }

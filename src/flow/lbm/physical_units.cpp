@@ -70,7 +70,17 @@ std::string to_string(FlowGeometry geometry) {
   return "unknown";
 }
 
-double FlowUnits::steps_for(double s) const { return std::ceil(s / dt - 1e-9); }
+double FlowUnits::checked_steps(double s, const std::string& option, bool below_one_step_ok) const {
+  const double steps = std::ceil(s / dt - 1e-9);
+  const char* sets_dt = "set by --dx, --tau, --plasma-viscosity and --plasma-density";
+  if (!(steps <= kMaxSteps))
+    throw Error(fmt::format("{} {} s is {:.3g} lattice steps of dt = {:.4g} s ({}): more than the {:.3g} a run can "
+                            "count",
+                            option, s, s / dt, dt, sets_dt, kMaxSteps));
+  if (!below_one_step_ok && !(steps >= 1))
+    throw Error(fmt::format("{} {} s is shorter than one lattice step, dt = {:.4g} s ({})", option, s, dt, sets_dt));
+  return steps;
+}
 
 double FlowUnits::to_lattice_force(double newtons) const {
   const double h = dx();

@@ -71,9 +71,16 @@ struct FlowUnits {
   double section_lattice = 0;
 
   double dx() const { return input.dx_um * 1e-6; }
-  /// Seconds of `steps` lattice steps, and the steps (rounded up) to reach `seconds`.
+  /// Seconds of `steps` lattice steps.
   double seconds(double steps) const { return steps * dt; }
-  double steps_for(double seconds) const;
+  /// The most lattice steps a run counts: beyond 2^53 a step count is no longer exact as a double
+  /// (nor the run's time n dt), and far beyond it the 64-bit counters wrap.
+  static constexpr double kMaxSteps = 9007199254740992.0;
+  /// The lattice steps (rounded up, as a run steps to its end) to reach `seconds`, given by the
+  /// option `option`. Throws bendlab::Error naming the option, dt and what sets it where that is
+  /// less than one step (unless `below_one_step_ok`: a report interval shorter than a step reports
+  /// every step) or more than kMaxSteps.
+  double checked_steps(double seconds, const std::string& option, bool below_one_step_ok = false) const;
   /// Lattice velocity of a physical one (m/s) and back.
   double to_lattice_velocity(double u) const { return u * dt / dx(); }
   double to_physical_velocity(double u_lattice) const { return u_lattice * dx() / dt; }
