@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "bendlab/core/output_folder.hpp"
+
 namespace bendlab::cli {
 
 std::string extension_of(const std::filesystem::path& path) {
@@ -21,7 +23,7 @@ void require_extension(const std::string& option, const std::filesystem::path& p
 }
 
 void require_writable_parent(const std::string& option, const std::filesystem::path& path) {
-  const auto parent = path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
+  const auto parent = parent_folder(path);
   if (!std::filesystem::is_directory(parent))
     throw Error(fmt::format("{} '{}': folder '{}' does not exist", option, path.string(), parent.string()));
 }

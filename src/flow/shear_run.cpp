@@ -12,6 +12,7 @@
 #include "bendlab/capsule/shear_units.hpp"
 #include "bendlab/core/file_input.hpp"
 #include "bendlab/core/finite_check.hpp"
+#include "bendlab/core/output_folder.hpp"
 #include "bendlab/elasticity/elastic_law.hpp"
 #include "bendlab/flow/bim/bim_capsule_solver.hpp"
 #include "bendlab/flow/lbm/lbm_capsule_solver.hpp"
@@ -100,7 +101,7 @@ CapsuleRunResult run_shear(const ShearRunSpec& a, const ShearRunCallbacks& callb
   if (a.folder.empty()) throw Error("--out: no run folder given");
   if (fs::exists(a.folder) && !fs::is_directory(a.folder))
     throw Error(fmt::format("--out '{}' is a file, not a folder", a.folder.string()));
-  const fs::path parent = a.folder.has_parent_path() ? a.folder.parent_path() : fs::path(".");
+  const fs::path parent = parent_folder(a.folder);
   if (!fs::exists(a.folder) && !fs::is_directory(parent))
     throw Error(fmt::format("--out '{}': folder '{}' does not exist", a.folder.string(), parent.string()));
   if (a.resume && a.overwrite) throw Error("--resume and --overwrite exclude each other");
