@@ -12,6 +12,7 @@
 #include "bendlab/capsule/bodies_snapshot.hpp"
 #include "bendlab/capsule/checkpoint.hpp"
 #include "bendlab/capsule/run_folder.hpp"
+#include "bendlab/core/output_folder.hpp"
 #include "bendlab/mesh/mesh_io.hpp"
 
 namespace fs = std::filesystem;
@@ -45,6 +46,8 @@ namespace {
 // Two times closer than this (relative, at least 1) are the same: a resume to the checkpoint's
 // time completes the run instead of continuing it.
 constexpr double kSameTime = 1e-12;
+// A step this close to a snapshot's due time (relative to the interval) takes the snapshot.
+constexpr double kScheduleTolerance = 1e-9;
 
 void check_options(const CapsuleRunOptions& o) {
   if (o.folder.empty()) throw Error("capsule run: no output folder");
@@ -58,7 +61,7 @@ void check_options(const CapsuleRunOptions& o) {
     throw Error("capsule run: arguments and summary_fields must be JSON objects");
   if (fs::exists(o.folder) && !fs::is_directory(o.folder))
     throw Error(fmt::format("'{}' is a file, not a folder", o.folder.string()));
-  const fs::path parent = o.folder.has_parent_path() ? o.folder.parent_path() : fs::path(".");
+  const fs::path parent = parent_folder(o.folder);
   if (!fs::exists(o.folder) && !fs::is_directory(parent))
     throw Error(fmt::format("'{}': folder '{}' does not exist (a run creates its own folder only)",
                             o.folder.string(), parent.string()));
@@ -112,7 +115,11 @@ class Run {
     const double largest_step = recorder_.check_resume(folder, saved, o_.t_end, o_.writes_files, source);
     if (const std::string diff = compare_arguments(o_.arguments, saved.arguments); !diff.empty())
       throw Error(fmt::format("resume: the arguments differ from the run in '{}': {}", folder.string(), diff));
-    const bool completing = std::abs(o_.t_end - saved.time) <= kSameTime * std::max(1.0, std::abs(saved.time));
+    // The final checkpoint of a run lies at its last step's time, at or a little past t_end (a
+    // lattice step, or a report interval, past it): it completes a run to the same t_end.
+    auto same = [](double a, double b) { return std::abs(a - b) <= kSameTime * std::max(1.0, std::abs(b)); };
+    const bool completing =
+        same(o_.t_end, saved.time) || (saved.final_for_t_end && same(o_.t_end, *saved.final_for_t_end));
     if (!completing && !(o_.t_end > saved.time))
       throw Error(fmt::format("resume: t_end (--t-end) {} is before the checkpoint's {} = {} in '{}'; a run "
                               "continues to a later end, or to the checkpoint's own to complete its files (start a "
@@ -140,7 +147,7 @@ class Run {
   // reports. Returns false when stopped before t_end (stop_after_steps, should_stop).
   bool advance() {
     const double t_start = solver_.time();
-    double next_snapshot = (state_.snapshots.empty() ? state_.time : state_.snapshots.back().first) + o_.snapshot_every;
+    double next_snapshot = next_snapshot_time();
     double last_progress = -std::numeric_limits<double>::infinity();
     std::int64_t steps_here = 0;
     bool stopped = false;
@@ -161,9 +168,10 @@ class Run {
         last_good_time = s.time;
         recorder_.record(s);
         const bool at_end = s.time >= o_.t_end - 1e-12;
-        if (s.time >= next_snapshot - 1e-9 * o_.snapshot_every || at_end) {
-          write_checkpoint(*s.positions, s.time);
-          next_snapshot += o_.snapshot_every;
+        const bool on_schedule = s.time >= next_snapshot - kScheduleTolerance * o_.snapshot_every;
+        if (on_schedule || at_end) {
+          write_checkpoint(*s.positions, s.time, at_end ? std::optional<double>(o_.t_end) : std::nullopt);
+          if (on_schedule) next_snapshot += o_.snapshot_every;
         }
         const double now = elapsed();
         if (o_.on_progress && (now - last_progress >= o_.progress_interval_seconds || at_end)) {
@@ -226,9 +234,27 @@ class Run {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   }
 
+  // When the next snapshot is due: the first step at or after origin + k * snapshot_every for the
+  // next k, origin the time of snapshot 0 (the run's start). An uninterrupted run adds one interval
+  // per snapshot on schedule, so a resumed run counts the snapshots it has instead of adding an
+  // interval to the last one's time (a step past its due time, which would shift every later
+  // snapshot and checkpoint from the uninterrupted run's). A snapshot taken before its due time
+  // was a final one only (at an earlier t_end) and is not counted.
+  double next_snapshot_time() const {
+    const auto& snaps = state_.snapshots;
+    if (snaps.empty()) return state_.time + o_.snapshot_every;
+    const double origin = snaps.front().first;
+    auto due = [&](std::size_t k) { return origin + static_cast<double>(k) * o_.snapshot_every; };
+    std::size_t on_schedule = snaps.size() - 1;  // snapshots after snapshot 0
+    if (on_schedule > 0 && snaps.back().first < due(on_schedule) - kScheduleTolerance * o_.snapshot_every)
+      --on_schedule;
+    return due(on_schedule + 1);
+  }
+
   // A snapshot of the bodies, then the checkpoint that lists it; the side files of the checkpoint
-  // before are removed once the new one is committed.
-  void write_checkpoint(const Points& x, double t) {
+  // before are removed once the new one is committed. `final_for` is the t_end that this
+  // checkpoint ends the run at (the last step reaches it, usually a little past it).
+  void write_checkpoint(const Points& x, double t, std::optional<double> final_for = std::nullopt) {
     const std::string tag = fmt::format("{:05d}", state_.snapshots.size());
     const std::string name = fmt::format("snapshot_{}.vtp", tag);
     if (o_.writes_files) write_bodies_snapshot(o_.folder / name, solver_.bodies(), x);
@@ -238,6 +264,7 @@ class Run {
     const std::vector<std::string> old_side_files = state_.solver_state.side_files;
     state_.solver_state = solver_.save_state(o_.folder, tag);
     state_.time = t;
+    state_.final_for_t_end = final_for;
     if (!o_.writes_files) return;
     state_.positions = x;
     state_.counters = solver_.counters();

@@ -67,6 +67,7 @@ nlohmann::json CapsuleCheckpoint::to_json() const {
           {"snapshots", snapshots},
           {"solver_state", solver_state.fields},
           {"side_files", solver_state.side_files}};
+  if (final_for_t_end) j["final_for_t_end"] = *final_for_t_end;
   for (const auto& [key, value] : recorder.items()) {
     if (j.contains(key)) throw Error(fmt::format("checkpoint: the recorder's key \"{}\" is the checkpoint's own", key));
     j[key] = value;
@@ -143,9 +144,15 @@ CapsuleCheckpoint CapsuleCheckpoint::from_json(const nlohmann::json& j, int num_
   }
   static const std::set<std::string> own = {"format",        "version",  "arguments", "solver",       "time",
                                             "vertices",      "positions", "steps",    "wall_seconds", "counters",
-                                            "snapshots",     "solver_state", "side_files"};
+                                            "snapshots",     "solver_state", "side_files", "final_for_t_end"};
   for (const auto& [key, value] : j.items())
     if (!own.count(key)) c.recorder[key] = value;
+  if (j.contains("final_for_t_end")) {
+    c.final_for_t_end = r.number("final_for_t_end", 0);
+    if (!(*c.final_for_t_end > 0) || *c.final_for_t_end > c.time * (1 + 1e-12) + 1e-12)
+      r.fail("final_for_t_end", fmt::format("must be positive and at most the checkpoint's time {}, got {}", c.time,
+                                            *c.final_for_t_end));
+  }
   return c;
 }
 

@@ -263,6 +263,9 @@ TEST_F(CapsuleRun, CheckpointIsValidatedAsAWhole) {
   refused(edited([](auto& j) { j["snapshots"] = {{1e9, "snapshot_00000.vtp"}}; }), "snapshots");
   refused(edited([](auto& j) { j["solver_state"]["dt_next"] = nullptr; }), "dt_next");
   refused(edited([](auto& j) { j["solver"] = "lbm"; }), "solver");
+  // The end a final checkpoint was written for lies at or before its own time.
+  refused(edited([](auto& j) { j["final_for_t_end"] = 1.0; }), "\"final_for_t_end\"");
+  refused(edited([](auto& j) { j["final_for_t_end"] = "x"; }), "\"final_for_t_end\"");
   {
     spit(cp, edited([](auto& j) { j["arguments"]["G"] = 0.2; }));
     auto fresh = solver();
@@ -285,6 +288,7 @@ TEST_F(CapsuleRun, CheckpointIsValidatedAsAWhole) {
             j["snapshots"].erase(j["snapshots"].size() - 1);
             j["snapshots"].erase(j["snapshots"].size() - 1);
             j["time"] = j["snapshots"].back()[0];
+            j.erase("final_for_t_end");  // no longer the run's final checkpoint
           }),
           "would overwrite");
   // A checkpoint names no file of the run as a side file to delete.

@@ -13,6 +13,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -89,6 +90,30 @@ class Cli : public ::testing::Test {
     EXPECT_FALSE(fs::exists(out)) << out;
     for (const auto& entry : fs::directory_iterator(dir))
       EXPECT_EQ(entry.path().filename().string().find(".tmp"), std::string::npos) << entry.path();
+  }
+  // Two run folders hold the same files, byte for byte: every file but timing.json (the clock), and
+  // checkpoint.json but its "wall_seconds" (the clock). Snapshots, fluid slices, side files and
+  // the checkpoint's list of snapshots included.
+  static void expect_same_run_files(const fs::path& a, const fs::path& b) {
+    auto names = [](const fs::path& folder) {
+      std::vector<std::string> n;
+      for (const auto& entry : fs::directory_iterator(folder)) n.push_back(entry.path().filename().string());
+      std::sort(n.begin(), n.end());
+      return n;
+    };
+    const std::vector<std::string> na = names(a);
+    EXPECT_EQ(na, names(b));
+    for (const std::string& name : na) {
+      if (name == "timing.json") continue;
+      if (name == "checkpoint.json") {
+        nlohmann::json ca = nlohmann::json::parse(slurp(a / name)), cb = nlohmann::json::parse(slurp(b / name));
+        ca.erase("wall_seconds");
+        cb.erase("wall_seconds");
+        EXPECT_EQ(ca, cb) << name;
+        continue;
+      }
+      EXPECT_TRUE(slurp(a / name) == slurp(b / name)) << name << " differs between " << a << " and " << b;
+    }
   }
   fs::path dir;
 };

@@ -369,6 +369,26 @@ TEST_F(Cli, ComparingWithASurfaceTheNodesAreNotOnIsRefused) {
   EXPECT_EQ(run("forces --mesh " + sphere.string() + " --method C --shape sphere --out " + out.string()).status, 0);
 }
 
+TEST_F(Cli, ShearLbmStoppedAtAnyReportAndResumedWritesEveryFileOfTheUninterruptedRun) {
+  // 4 reports, a snapshot and checkpoint after the 2nd and the 4th: a stop after the 3rd resumes
+  // from the first snapshot, and its next one must come at the uninterrupted run's step.
+  const std::string common = " --solver lbm --radius-lu 4 --box 2.5,2.5,3 --mesh mt1:320 --G 0.1 --t-end 0.02 "
+                             "--snapshot-every 0.01 --sample-every 0.005 --no-plot --out ";
+  const fs::path full = dir / "full";
+  CliRun r = run("shear" + common + full.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (int k : {1, 2, 3}) {
+    SCOPED_TRACE(k);
+    const fs::path parts = dir / ("parts" + std::to_string(k));
+    r = run("shear --stop-after-steps " + std::to_string(k) + common + parts.string());
+    ASSERT_EQ(r.status, 0) << r.err;
+    ASSERT_FALSE(fs::exists(parts / "summary.json"));
+    r = run("shear --resume" + common + parts.string());
+    ASSERT_EQ(r.status, 0) << r.err;
+    expect_same_run_files(full, parts);
+  }
+}
+
 TEST_F(Cli, ShearStoppedAndResumedEqualsUninterrupted) {
   const std::string common = " --mesh mt1:320 --G 0.1 --t-end 0.3 --snapshot-every 0.1 --no-plot --out ";
   const fs::path full = dir / "full", parts = dir / "parts";

@@ -34,33 +34,6 @@ def same_series(a, b, what):
     assert ta == tb, f"{what}: the time series differ\n{ta}\n{tb}"
 
 
-with tempfile.TemporaryDirectory() as d:
-    d = pathlib.Path(d)
-    serial = run([bendlab] + ARGS + ["--out", str(d / "serial")])
-    par = run(MPI + [bendlab] + ARGS + ["--out", str(d / "par")])
-    assert sorted(os.listdir(d / "serial")) == sorted(os.listdir(d / "par")), (os.listdir(d / "serial"), os.listdir(d / "par"))
-    same_series(d / "serial", d / "par", "mpirun")
-    assert len(par.stdout.strip().splitlines()) == 1, f"summary printed {len(par.stdout.splitlines())} times"
-    a, b = json.loads(serial.stdout), json.loads(par.stdout)
-    assert a == b, (a, b)
-    # Interrupted on N ranks, resumed by the serial program.
-    run(MPI + [bendlab] + ARGS + ["--out", str(d / "resumed"), "--stop-after-steps", "5"])
-    run([bendlab] + ARGS + ["--out", str(d / "resumed"), "--resume"])
-    same_series(d / "serial", d / "resumed", "resume")
-    # A refused option on every rank: a non-zero status and one line, from rank 0, naming it.
-    (d / "file").write_text("")
-    bad = run(MPI + [bendlab] + ARGS + ["--out", str(d / "file")], check=False)
-    assert bad.returncode != 0, "an error must end the run with a non-zero status"
-    assert "error: --out" in bad.stderr and "is a file, not a folder" in bad.stderr, bad.stderr
-    assert bad.stderr.count("error: --out") == 1, bad.stderr
-    assert "rank" not in bad.stderr.split("error: --out")[0].splitlines()[-1], bad.stderr
-
-# Many cells: each rank owns whole cells (docs/mpi.md, "Many cells").
-FLOW = ["flow", "--geometry", "tube", "--diameter", "9", "--length", "12", "--dx", "0.5", "--tau", "1",
-        "--pseudo-shear-rate", "100", "--cells", "2", "--mesh", "mt1:320", "--t-end", "4e-5", "--sample-every", "4e-6",
-        "--snapshot-every", "2e-5"]
-
-
 def same_files(a, b, what, but=("timing.json",)):
     names = sorted(os.listdir(a))
     assert names == sorted(os.listdir(b)), (what, names, sorted(os.listdir(b)))
@@ -75,18 +48,50 @@ def same_files(a, b, what, but=("timing.json",)):
 
 with tempfile.TemporaryDirectory() as d:
     d = pathlib.Path(d)
+    serial = run([bendlab] + ARGS + ["--out", str(d / "serial")])
+    par = run(MPI + [bendlab] + ARGS + ["--out", str(d / "par")])
+    assert sorted(os.listdir(d / "serial")) == sorted(os.listdir(d / "par")), (os.listdir(d / "serial"), os.listdir(d / "par"))
+    same_series(d / "serial", d / "par", "mpirun")
+    assert len(par.stdout.strip().splitlines()) == 1, f"summary printed {len(par.stdout.splitlines())} times"
+    a, b = json.loads(serial.stdout), json.loads(par.stdout)
+    assert a == b, (a, b)
+    # Interrupted on N ranks after the first snapshot (the 4th report), resumed by the serial program:
+    # every file of the uninterrupted run, the later snapshots and checkpoints at its steps.
+    run(MPI + [bendlab] + ARGS + ["--out", str(d / "resumed"), "--stop-after-steps", "5"])
+    run([bendlab] + ARGS + ["--out", str(d / "resumed"), "--resume"])
+    same_series(d / "serial", d / "resumed", "resume")
+    same_files(d / "serial", d / "resumed", "resume")
+    # A refused option on every rank: a non-zero status and one line, from rank 0, naming it.
+    (d / "file").write_text("")
+    bad = run(MPI + [bendlab] + ARGS + ["--out", str(d / "file")], check=False)
+    assert bad.returncode != 0, "an error must end the run with a non-zero status"
+    assert "error: --out" in bad.stderr and "is a file, not a folder" in bad.stderr, bad.stderr
+    assert bad.stderr.count("error: --out") == 1, bad.stderr
+    assert "rank" not in bad.stderr.split("error: --out")[0].splitlines()[-1], bad.stderr
+
+# Many cells: each rank owns whole cells (docs/mpi.md, "Many cells").
+FLOW = ["flow", "--geometry", "tube", "--diameter", "9", "--length", "12", "--dx", "0.5", "--tau", "1",
+        "--pseudo-shear-rate", "100", "--cells", "2", "--mesh", "mt1:320", "--t-end", "4e-5", "--sample-every", "4e-6",
+        "--snapshot-every", "2e-5"]
+
+
+with tempfile.TemporaryDirectory() as d:
+    d = pathlib.Path(d)
     serial = run([bendlab] + FLOW + ["--out", str(d / "serial")])
     par = run(MPI + [bendlab] + FLOW + ["--out", str(d / "par")])
     same_series(d / "serial", d / "par", "flow, mpirun")
     same_files(d / "serial", d / "par", "flow, mpirun")
     assert len(par.stdout.strip().splitlines()) == 1, f"summary printed {len(par.stdout.splitlines())} times"
-    # Interrupted on N ranks and resumed by the serial program, and the other way round.
-    run(MPI + [bendlab] + FLOW + ["--out", str(d / "resumed"), "--stop-after-steps", "4"])
-    run([bendlab] + FLOW + ["--out", str(d / "resumed"), "--resume"])
-    same_series(d / "serial", d / "resumed", "flow, resumed by the serial command")
-    run([bendlab] + FLOW + ["--out", str(d / "resumed2"), "--stop-after-steps", "4"])
-    run(MPI + [bendlab] + FLOW + ["--out", str(d / "resumed2"), "--resume"])
-    same_series(d / "serial", d / "resumed2", "flow, resumed on N ranks")
+    # Interrupted on N ranks and resumed by the serial program, and the other way round, before the
+    # first snapshot (the 5th report) and after it: every file of the uninterrupted run.
+    for stop in ("4", "7"):
+        run(MPI + [bendlab] + FLOW + ["--out", str(d / f"resumed{stop}"), "--stop-after-steps", stop])
+        run([bendlab] + FLOW + ["--out", str(d / f"resumed{stop}"), "--resume"])
+        same_files(d / "serial", d / f"resumed{stop}", f"flow stopped after {stop} reports, resumed by the serial command")
+        run([bendlab] + FLOW + ["--out", str(d / f"resumed2_{stop}"), "--stop-after-steps", stop])
+        run(MPI + [bendlab] + FLOW + ["--out", str(d / f"resumed2_{stop}"), "--resume"])
+        same_files(d / "serial", d / f"resumed2_{stop}", f"flow stopped after {stop} reports, resumed on N ranks")
+    same_series(d / "serial", d / "resumed7", "flow, resumed by the serial command")
     # The shear box stays on one process: refused on every rank with one line.
     bad = run(MPI + [bendlab, "flow", "--geometry", "shear", "--height", "10", "--width", "10", "--length", "10",
                      "--shear-rate", "100", "--cells", "1", "--out", str(d / "shear")], check=False)

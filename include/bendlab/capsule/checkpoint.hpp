@@ -17,6 +17,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -41,6 +42,10 @@ struct CapsuleCheckpoint {
   nlohmann::json recorder = nlohmann::json::object();
   std::vector<std::pair<double, std::string>> snapshots;
   SolverState solver_state;
+  /// Set on the last checkpoint of a run that reached its end: that run's t_end ("final_for_t_end",
+  /// absent otherwise). A resume to the same t_end completes the run's files from it, although
+  /// `time` (the last step's) lies past t_end.
+  std::optional<double> final_for_t_end;
 
   nlohmann::json to_json() const;
   /// Validates the whole document before returning; `source` names it in errors, which also name
