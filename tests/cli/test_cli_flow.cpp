@@ -33,9 +33,14 @@ std::vector<double> column(const std::string& csv, const std::string& name) {
   std::vector<double> v;
   if (index < 0) return v;
   while (std::getline(in, line)) {
-    std::istringstream row(line);
-    for (int k = 0; std::getline(row, cell, ','); ++k)
-      if (k == index) v.push_back(std::stod(cell));
+    // Split at every comma: an empty field (an undefined value, NaN) may also be the last one.
+    std::size_t begin = 0;
+    for (int k = 0; k <= index; ++k) {
+      const std::size_t comma = line.find(',', begin);
+      cell = line.substr(begin, comma == std::string::npos ? std::string::npos : comma - begin);
+      begin = comma == std::string::npos ? line.size() : comma + 1;
+    }
+    v.push_back(cell.empty() ? std::nan("") : std::stod(cell));
   }
   return v;
 }
@@ -64,6 +69,42 @@ TEST_F(Cli, FlowRefusesBadInputWithOneLineBeforeWork) {
   expect_refused(run("flow --hematocrit 0 --method M --option degree=9" + tube), "degree", out);
   expect_refused(run("flow --hematocrit 0 --method none --bending-net-force remove" + tube), "--bending-net-force", out);
   expect_refused(run("flow --hematocrit 0 --bending-net-force drop" + tube), "--bending-net-force", out);
+  // A lattice viscosity near 0 could not develop the cell-free flow in any run's time.
+  expect_refused(run("flow --hematocrit 0 --tau 0.500001" + tube), "--tau 0.500001", out);
+  // Step counts beyond what a run can count (they wrapped to 0 steps or a row every step), and a
+  // run shorter than one step (no step, no sample: NaN profiles).
+  auto small = [&](const std::string& from, const std::string& to) {
+    std::string options = kSmallTube;
+    options.replace(options.find(from), from.size(), to);
+    return "flow --hematocrit 0" + options + " --out " + out.string();
+  };
+  expect_refused(run(small("--t-end 8e-6", "--t-end 1e30")), "--t-end 1e+30 s is", out);
+  expect_refused(run(small("--t-end 8e-6", "--t-end 8e-6 --plasma-viscosity 1e30")), "--t-end", out);
+  expect_refused(run(small("--sample-every 1e-6", "--sample-every 1e30")), "--sample-every", out);
+  expect_refused(run(small("--t-end 8e-6", "--t-end 1e-320")), "shorter than one lattice step", out);
+}
+
+TEST_F(Cli, FlowWritesNoNonFiniteNumber) {
+  // Without cells there is no cell-free layer: an empty field, not "nan".
+  for (const char* cells : {"--cells 0", "--hematocrit 0"}) {
+    const fs::path out = dir / (std::string("r") + cells[2]);
+    const CliRun r = run(std::string("flow ") + cells + kSmallTube + " --out " + out.string());
+    ASSERT_EQ(r.status, 0) << r.err;
+    for (const char* file : {"timeseries.csv", "profiles.csv", "summary.json"}) {
+      const std::string text = slurp(out / file);
+      EXPECT_EQ(text.find("nan"), std::string::npos) << file << ":\n" << text;
+      EXPECT_EQ(text.find("inf"), std::string::npos) << file << ":\n" << text;
+    }
+    const std::vector<double> layer = column(slurp(out / "timeseries.csv"), "cell_free_layer_um");
+    ASSERT_FALSE(layer.empty());
+    for (double v : layer) EXPECT_TRUE(std::isnan(v));
+  }
+}
+
+TEST_F(Cli, FlowTakesANewFolderWithATrailingSlash) {
+  const CliRun r = run("flow --hematocrit 0" + kSmallTube + " --out " + (dir / "r").string() + "/");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(fs::exists(dir / "r" / "summary.json"));
 }
 
 TEST_F(Cli, FlowBendingNetForceRemovalIsPartOfTheRun) {
@@ -139,6 +180,46 @@ TEST_F(Cli, FlowStoppedAndResumedEqualsUninterrupted) {
   r = run("flow --cells 2 --resume --seed 7" + kSmallTube + " --out " + parts.string());
   EXPECT_NE(r.status, 0);
   EXPECT_NE(r.err.find("seed"), std::string::npos) << r.err;
+}
+
+TEST_F(Cli, FlowStoppedAtAnyReportAndResumedWritesEveryFileOfTheUninterruptedRun) {
+  // 8 reports, a snapshot and checkpoint after the 4th and the 8th. A stop after the first
+  // snapshot resumes from it: its later snapshots must come at the uninterrupted run's steps, not
+  // one interval after the snapshot's own (later) time.
+  const fs::path full = dir / "full";
+  CliRun r = run("flow --cells 2" + kSmallTube + " --out " + full.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (int k : {1, 4, 5, 7}) {
+    SCOPED_TRACE(k);
+    const fs::path parts = dir / ("parts" + std::to_string(k));
+    r = run("flow --cells 2 --stop-after-steps " + std::to_string(k) + kSmallTube + " --out " + parts.string());
+    ASSERT_EQ(r.status, 0) << r.err;
+    ASSERT_FALSE(fs::exists(parts / "summary.json"));
+    r = run("flow --cells 2 --resume" + kSmallTube + " --out " + parts.string());
+    ASSERT_EQ(r.status, 0) << r.err;
+    expect_same_run_files(full, parts);
+  }
+}
+
+TEST_F(Cli, FlowStoppedBetweenItsFinalCheckpointAndItsSummaryIsCompletedByAResume) {
+  // The final checkpoint lies at the last lattice step, a little past --t-end: a resume to the
+  // same --t-end takes no step and writes the summary (as after a kill, or a full disk, there).
+  const fs::path full = dir / "full", cut = dir / "cut";
+  CliRun r = run("flow --cells 2" + kSmallTube + " --out " + full.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  r = run("flow --cells 2" + kSmallTube + " --out " + cut.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  fs::remove(cut / "summary.json");
+  fs::remove(cut / "timing.json");
+  r = run("flow --cells 2 --resume" + kSmallTube + " --out " + cut.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  expect_same_run_files(full, cut);
+  // An earlier end than the run reached is still refused.
+  std::string earlier = kSmallTube;
+  earlier.replace(earlier.find("--t-end 8e-6"), 12, "--t-end 6e-6");
+  r = run("flow --cells 2 --resume" + earlier + " --out " + cut.string());
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.err.find("before the checkpoint"), std::string::npos) << r.err;
 }
 
 TEST_F(Cli, FlowShearWithoutCellsHasThePlasmaViscosity) {
