@@ -5,7 +5,10 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include <cerrno>
+#include <cmath>
 #include <chrono>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <optional>
@@ -14,6 +17,7 @@
 #include "bendlab/core/atomic_file.hpp"
 #include "bendlab/core/folder_lock.hpp"
 #include "bendlab/core/helper_program.hpp"
+#include "bendlab/core/output_folder.hpp"
 #include "bendlab/flow/optical_stretch.hpp"
 #include "bendlab/mesh/mesh_io.hpp"
 #include "command.hpp"
@@ -26,6 +30,7 @@ namespace fs = std::filesystem;
 
 struct StretchArgs {
   std::string out;
+  std::string forces = "0,25,50,75,100,125,150,175,193";
   bool overwrite = false;
   bool plots = true;
   std::string plot_script;
@@ -51,7 +56,7 @@ bool is_stretch_file(const std::string& name) {
 // --overwrite, which removes the files of an earlier stretch run and nothing else.
 void prepare_folder(const fs::path& out, bool overwrite) {
   if (out.empty()) throw Error("--out: no output folder given");
-  const fs::path parent = out.has_parent_path() ? out.parent_path() : fs::path(".");
+  const fs::path parent = parent_folder(out);
   if (!fs::is_directory(parent))
     throw Error(fmt::format("--out '{}': folder '{}' does not exist", out.string(), parent.string()));
   if (fs::exists(out) && !fs::is_directory(out))
@@ -85,10 +90,14 @@ void write_csv(const fs::path& path, const std::vector<StretchPoint>& points) {
   std::ostream& o = f.stream();
   o << "force_pN,axial_diameter_um,transverse_diameter_um,iterations,residual_pN,area_change,volume_change,"
        "converged,extent_y_um,extent_z_um\n";
+  // A number that is not finite (a relaxation that failed) is written as an empty field, as in
+  // every result file of bendlab: undefined, never "inf" or "nan".
+  auto number = [](double v) { return std::isfinite(v) ? fmt::format("{:.17g}", v) : std::string(); };
   for (const StretchPoint& p : points)
-    o << fmt::format("{:.17g},{:.17g},{:.17g},{},{:.17g},{:.17g},{:.17g},{},{:.17g},{:.17g}\n", p.force_pN,
-                     p.measures.axial_um, p.measures.transverse_um, p.iterations, p.residual_pN, p.area_change,
-                     p.volume_change, p.converged ? 1 : 0, p.measures.extent_y_um, p.measures.extent_z_um);
+    o << fmt::format("{},{},{},{},{},{},{},{},{},{}\n", number(p.force_pN), number(p.measures.axial_um),
+                     number(p.measures.transverse_um), p.iterations, number(p.residual_pN), number(p.area_change),
+                     number(p.volume_change), p.converged ? 1 : 0, number(p.measures.extent_y_um),
+                     number(p.measures.extent_z_um));
   f.commit();
 }
 
@@ -119,8 +128,30 @@ void run_plot(const StretchArgs& a, const fs::path& out) {
   }
 }
 
+// --forces: numbers separated by single commas. Every entry counts: "1,,2", "1,2," and ",1" are
+// refused (a list split by CLI11 drops empty entries without a word).
+std::vector<double> parse_forces(const std::string& text) {
+  std::vector<double> forces;
+  std::size_t begin = 0;
+  for (int k = 1;; ++k) {
+    const std::size_t comma = text.find(',', begin);
+    const std::string entry = text.substr(begin, comma == std::string::npos ? std::string::npos : comma - begin);
+    if (entry.empty())
+      throw Error(fmt::format("--forces '{}': entry {} is empty (give forces in pN separated by single commas)", text, k));
+    char* end = nullptr;
+    errno = 0;
+    const double value = std::strtod(entry.c_str(), &end);
+    if (end != entry.c_str() + entry.size() || errno == ERANGE)
+      throw Error(fmt::format("--forces '{}': entry {} '{}' is not a number of pN", text, k, entry));
+    forces.push_back(value);
+    if (comma == std::string::npos) return forces;
+    begin = comma + 1;
+  }
+}
+
 void stretch(StretchArgs& a) {
   StretchSpec& s = a.spec;
+  s.forces_pN = parse_forces(a.forces);
   s.cell.method_options = a.options;
   if (s.cell.bending_modulus > 0 && s.cell.method == "none")
     throw Error("--method none needs --bending-modulus 0");
@@ -206,7 +237,6 @@ void stretch(StretchArgs& a) {
 const CommandRegistration stretch_registration([](CLI::App& app) {
   auto args = std::make_shared<StretchArgs>();
   StretchSpec& s = args->spec;
-  s.forces_pN = {0, 25, 50, 75, 100, 125, 150, 175, 193};
   auto* cmd = app.add_subcommand(
       "stretch",
       "Optical-tweezers stretching of a red blood cell in physical units (Mills et al. 2004): a total force F pulls "
@@ -218,8 +248,7 @@ const CommandRegistration stretch_registration([](CLI::App& app) {
       "volume_change = V/V0 - 1, converged, extent_y_um, extent_z_um), summary.json, shape_NNN.vtp per force (with "
       "the membrane and applied forces), shapes.pvd and stretch.png (against the experiment). The defaults are "
       "bendlab flow's red blood cell (docs/conventions.md §6-7)");
-  cmd->add_option("--forces", s.forces_pN, "comma-separated total forces at each end, pN (>= 0), run in this order")
-      ->delimiter(',')
+  cmd->add_option("--forces", args->forces, "comma-separated total forces at each end, pN (>= 0), run in this order")
       ->capture_default_str();
   cmd->add_option("--fraction", s.fraction,
                   "fraction of the vertices pulled at each end, in (0, 0.5]: round(fraction N) vertices")

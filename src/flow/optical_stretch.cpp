@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 
 #include "bendlab/geometry/measures.hpp"
@@ -18,7 +19,16 @@ void require(bool ok, const std::string& message) {
 
 constexpr int kMaxRestarts = 8;
 
-double max_row_norm(const Points& a) { return a.rows() > 0 ? a.rowwise().norm().maxCoeff() : 0.0; }
+// The largest row length, without the overflow of a squared norm (a force of 1e308 pN has a
+// length, not an infinite one).
+double max_row_norm(const Points& a) {
+  double largest = 0;
+  for (Eigen::Index i = 0; i < a.rows(); ++i) {
+    const double n = a.row(i).stableNorm();
+    if (!(n <= largest)) largest = n;  // NaN is kept: a non-finite row is not hidden
+  }
+  return largest;
+}
 
 }  // namespace
 
@@ -133,6 +143,21 @@ OpticalStretch::OpticalStretch(StretchSpec spec)
   membrane_force_ = Points::Zero(n_vertices, 3);
   reference_measures_ = stretch_measures(membrane_->topology(), x_);
   mean_edge_um_ = kind_.mean_edge_um;
+  // The membrane's stiffness at the reference shape sets the relaxation's step: moduli whose forces
+  // overflow are refused here, before any output, with the options that set them.
+  double lambda = 0;
+  std::string why;
+  try {
+    lambda = estimate_lambda(Points::Zero(n_vertices, 3));
+  } catch (const Error& e) {
+    why = std::string(": ") + e.what();
+  }
+  if (!std::isfinite(lambda))
+    throw Error(fmt::format("--shear-modulus {} N/m, --skalak-c {}, --bending-modulus {} J, --volume-ratio {}: the "
+                            "membrane's forces are not finite numbers near its reference shape{} (a modulus beyond "
+                            "what double precision can hold)",
+                            spec_.cell.shear_modulus, spec_.cell.skalak_c, spec_.cell.bending_modulus,
+                            spec_.cell.volume_modulus_ratio, why));
 }
 
 Points OpticalStretch::applied_forces(double force_pN) const {
@@ -160,6 +185,9 @@ double OpticalStretch::estimate_lambda(const Points& applied) {
     membrane_->forces(x_ + h * v, f1);
     const Points jv = (f1 - f0) / h;
     const double ratio = jv.norm() / v.norm();
+    // A force that overflows (moduli beyond double precision) has no stable step: say so rather
+    // than keep the NaN out of the maximum and step blindly.
+    if (!std::isfinite(ratio)) return std::numeric_limits<double>::infinity();
     lambda = std::max(lambda, ratio);
     if (!(jv.norm() > 0)) break;
     v = jv;

@@ -54,6 +54,34 @@ TEST_F(Cli, StretchRefusesBadInputWithOneLineBeforeWork) {
   expect_refused(run("stretch --mesh mt1:7 --no-plots --out " + out.string()), "mt1:7", out);
   expect_refused(run("stretch" + kCoarse + " --out " + (dir / "missing" / "r").string()), "does not exist",
                  dir / "missing");
+  // Every entry of the list counts: an empty one is refused, not dropped.
+  for (const char* forces : {"1,,2", "1,2,", ",1"})
+    expect_refused(run(std::vector<std::string>{"stretch", "--forces", forces, "--mesh", "mt1:320", "--no-plots",
+                                                "--out", out.string()}),
+                   "--forces", out);
+  expect_refused(run(std::vector<std::string>{"stretch", "--forces", "", "--out", out.string()}), "--forces", out);
+  // Moduli whose forces overflow double precision are refused by name, before the folder exists.
+  expect_refused(run("stretch --mesh mt1:80 --forces 0,10 --skalak-c 1e308 --no-plots --out " + out.string()),
+                 "--skalak-c 1e+308", out);
+}
+
+TEST_F(Cli, StretchWritesNoNonFiniteNumberWhenARelaxationFails) {
+  // 1e308 pN: the residual is a length of 1e308 pN (not an infinite one); the relaxation fails in
+  // its budget, the run says so and exits non-zero, and stretch.csv holds only numbers.
+  const fs::path out = dir / "r";
+  const CliRun r = run("stretch --mesh mt1:80 --forces 1e308 --max-iterations 100 --no-plots --out " + out.string());
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.err.find("did not reach equilibrium"), std::string::npos) << r.err;
+  const std::string csv = slurp(out / "stretch.csv");
+  ASSERT_FALSE(csv.empty());
+  EXPECT_EQ(csv.find("inf"), std::string::npos) << csv;
+  EXPECT_EQ(csv.find("nan"), std::string::npos) << csv;
+}
+
+TEST_F(Cli, StretchTakesANewFolderWithATrailingSlash) {
+  const CliRun r = run("stretch --mesh mt1:80 --forces 0 --no-plots --out " + (dir / "r").string() + "/");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(fs::exists(dir / "r" / "stretch.csv"));
 }
 
 TEST_F(Cli, StretchWritesItsTablesShapesAndSummary) {
