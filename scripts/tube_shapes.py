@@ -75,7 +75,7 @@ class ShapeRun(study_runner.StudyRun):
     def arguments(self, out):
         return ["flow", "--geometry", "tube", "--diameter", fmt_g(DIAMETER), "--length", fmt_g(LENGTH),
                 "--dx", fmt_g(DX), "--tau", fmt_g(TAU), "--pseudo-shear-rate", fmt_g(self.rate),
-                "--cells", "1", "--seed", str(SEED), "--t-end", fmt_g(self.t_end),
+                "--cells", "1", "--seed", str(SEED), "--bending-net-force", "keep", "--t-end", fmt_g(self.t_end),
                 "--sample-every", fmt_g(self.t_end / 400), "--snapshot-every", fmt_g(self.t_end / SNAPSHOTS),
                 "--out", str(out)]
 

@@ -123,7 +123,9 @@ class Run(study_runner.StudyRun):
 
     def arguments(self, out):
         extra = ["--contact-cutoff", fmt_g(self.contact_cutoff)] if self.contact_cutoff else []
-        extra += ["--bending-net-force", self.net_force] if self.net_force != "keep" else []
+        # Explicit: the flow command removes the net force by default, and the study's runs keep it
+        # unless they say otherwise.
+        extra += ["--bending-net-force", self.net_force]
         return ["flow", "--geometry", "tube", "--diameter", fmt_g(self.diameter), "--length",
                 fmt_g(self.length_factor * self.diameter), "--dx", fmt_g(DX), "--tau", fmt_g(TAU),
                 "--pseudo-shear-rate", fmt_g(PSEUDO_SHEAR_RATE), "--hematocrit", fmt_g(self.hematocrit),

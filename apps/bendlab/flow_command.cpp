@@ -21,7 +21,8 @@ namespace bendlab::cli {
 namespace {
 
 struct FlowArgs {
-  std::string geometry = "tube", out, bending_net_force = "keep";
+  std::string geometry = "tube", out;
+  std::optional<std::string> bending_net_force;  // unset: remove where there is a bending force
   std::optional<double> diameter, height, width, pseudo_shear_rate, body_force, shear_rate, hematocrit;
   std::optional<int> cells;
   double length = 0;
@@ -61,7 +62,10 @@ void flow(FlowArgs& a) {
     throw Error(fmt::format("--contact-force {} pN must be >= 0 (0: the default G_s dx)", a.contact_force_pn));
   s.contact_force = a.contact_force_pn * 1e-12;
   s.cell.method_options = a.options;
-  s.cell.bending_without_net_force = a.bending_net_force == "remove";
+  // Momentum-conserving by default (docs/conventions.md §6): the net force and torque of the
+  // bending force are taken off each cell unless --bending-net-force keep.
+  const bool has_bending = s.cell.method != "none" && s.cell.bending_modulus > 0;
+  s.cell.bending_without_net_force = a.bending_net_force ? *a.bending_net_force == "remove" : has_bending;
   FlowRun::check_end(s, a.t_end);
 
   // Under mpirun: the fluid in y-slabs and each cell owned by one rank; rank 0 writes the run
@@ -90,6 +94,14 @@ void flow(FlowArgs& a) {
   o.overwrite = a.overwrite;
   o.stop_after_steps = a.stop_after_steps;
   o.on_note = note;
+  if (has_bending)
+    o.start_notes.push_back(
+        s.cell.bending_without_net_force
+            ? fmt::format("bending force: Method {}'s, its net force and torque removed on each cell{}", s.cell.method,
+                          a.bending_net_force ? "" : " (the default; --bending-net-force keep keeps them)")
+            : fmt::format("bending force: Method {}'s as the method gives it, net force and torque kept "
+                          "(--bending-net-force keep)",
+                          s.cell.method));
   o.writes_files = world.rank == 0;
   const double dt = run.units().dt;
   const double nodes = run.fluid_nodes();
@@ -155,9 +167,10 @@ const CommandRegistration flow_registration([](CLI::App& app) {
       ->check(CLI::IsMember(method_choices_with_none()))->capture_default_str();
   cmd->add_option("--option", args->options, "method option key=value, repeatable (bendlab methods)");
   cmd->add_option("--bending-net-force", args->bending_net_force,
-                  "keep: the bending method's force as it is; remove: take its net force and torque off each cell "
-                  "(momentum-conserving bending for Methods C, D, E, M, whose discrete force has them)")
-      ->check(CLI::IsMember({"keep", "remove"}))->capture_default_str();
+                  "remove (the default where there is a bending force): take the bending force's net force and "
+                  "torque off each cell, so that bending conserves momentum (the discrete forces of Methods C, D, "
+                  "E, ED, M and S have some; A, B and J have none); keep: the bending method's force as it is")
+      ->check(CLI::IsMember({"keep", "remove"}));
   cmd->add_option("--membrane", s.cell.elastic_law, "in-plane elastic law: skalak or neo-hookean")
       ->check(CLI::IsMember({"skalak", "neo-hookean"}))->capture_default_str();
   cmd->add_option("--shear-modulus", s.cell.shear_modulus, "membrane shear modulus G_s, N/m")->capture_default_str();

@@ -23,7 +23,7 @@ void bind_flow(py::module_& m) {
          std::optional<double> hematocrit,
          std::optional<int> cells, std::uint64_t seed, const std::string& cell, double cell_radius,
          const std::string& mesh, const std::string& method, const std::vector<std::string>& method_options,
-         const std::string& membrane, double shear_modulus, double skalak_c, double bending_modulus,
+         const std::optional<std::string>& bending_net_force, const std::string& membrane, double shear_modulus, double skalak_c, double bending_modulus,
          double volume_ratio, double contact_cutoff, double contact_force, double t_end, double sample_every,
          double snapshot_every, double steady_from, double slice_width, bool resume, bool overwrite,
          std::int64_t stop_after_steps, const py::object& progress, double progress_interval) -> py::object {
@@ -51,10 +51,15 @@ void bind_flow(py::module_& m) {
         s.cell.mesh = mesh;
         s.cell.method = method;
         s.cell.method_options = method_options;
+        if (bending_net_force && *bending_net_force != "keep" && *bending_net_force != "remove")
+          throw Error(fmt::format("bending_net_force '{}' is not keep or remove", *bending_net_force));
         s.cell.elastic_law = membrane;
         s.cell.shear_modulus = shear_modulus;
         s.cell.skalak_c = skalak_c;
         s.cell.bending_modulus = bending_modulus;
+        // As the flow command: remove the bending force's net force and torque unless told to keep them.
+        s.cell.bending_without_net_force = bending_net_force ? *bending_net_force == "remove"
+                                                             : method != "none" && bending_modulus > 0;
         s.cell.volume_modulus_ratio = volume_ratio;
         s.contact_cutoff_um = contact_cutoff;
         s.contact_force = contact_force;
@@ -89,7 +94,8 @@ void bind_flow(py::module_& m) {
       py::arg("tau") = 1.0, py::arg("pseudo_shear_rate") = py::none(), py::arg("body_force") = py::none(),
       py::arg("shear_rate") = py::none(), py::arg("hematocrit") = py::none(), py::arg("cells") = py::none(), py::arg("seed") = 1,
       py::arg("cell") = "rbc", py::arg("cell_radius") = 3.91, py::arg("mesh") = "mt1:1280", py::arg("method") = "C",
-      py::arg("method_options") = std::vector<std::string>{}, py::arg("membrane") = "skalak",
+      py::arg("method_options") = std::vector<std::string>{}, py::arg("bending_net_force") = py::none(),
+      py::arg("membrane") = "skalak",
       py::arg("shear_modulus") = 5.3e-6, py::arg("skalak_c") = 10.0, py::arg("bending_modulus") = 2e-19,
       py::arg("volume_ratio") = 100.0, py::arg("contact_cutoff") = 0.0, py::arg("contact_force") = 0.0,
       py::arg("t_end") = 0.01, py::arg("sample_every") = 1e-4, py::arg("snapshot_every") = 1e-3,

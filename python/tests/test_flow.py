@@ -28,6 +28,15 @@ def test_a_python_run_equals_the_cli_run_and_resumes_from_it(tmp_path, cli):
     assert bendlab.read_summary(tmp_path / "parts") == summary
 
 
+def test_the_bending_net_force_is_removed_by_default_as_on_the_command_line(tmp_path):
+    # The first test compares the defaults; here the two settings are part of the run's identity.
+    assert bendlab.flow_run(tmp_path / "removed", **SMALL)["bending_without_net_force"] is True
+    kept = bendlab.flow_run(tmp_path / "kept", bending_net_force="keep", **SMALL)
+    assert "bending_without_net_force" not in kept
+    with pytest.raises(ValueError, match="bending_net_force"):
+        bendlab.flow_run(tmp_path / "r", bending_net_force="drop", **SMALL)
+
+
 def test_bad_input_raises_value_error_naming_it(tmp_path):
     with pytest.raises(ValueError, match="tau"):
         bendlab.flow_run(tmp_path / "r", **dict(SMALL, tau=0.5))

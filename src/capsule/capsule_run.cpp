@@ -316,6 +316,8 @@ CapsuleRunResult run_solver(CapsuleSolver& solver, RunRecorder& recorder, const 
   Run run(solver, recorder, o);
   run.lock();
   const bool completing = o.resume ? run.resume() : (run.start_new(), false);
+  if (o.on_note)
+    for (const std::string& line : o.start_notes) o.on_note(line);
   if (!completing && !run.advance()) return {};
   return run.finish();
 }

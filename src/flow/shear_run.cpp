@@ -234,6 +234,12 @@ CapsuleRunResult run_shear(const ShearRunSpec& a, const ShearRunCallbacks& callb
   o.resume = a.resume;
   o.overwrite = a.overwrite;
   o.stop_after_steps = a.stop_after_steps;
+  // The capsule study takes the methods as published, net force and torque included (bendlab flow
+  // removes them by default: docs/conventions.md §6).
+  if (bending)
+    o.start_notes.push_back(fmt::format("bending force: Method {}'s as the method gives it, its net force and torque "
+                                        "kept (the paper's capsule study)",
+                                        bending->name()));
   o.max_steps = a.max_steps;
   // The run's identity (checked on resume): every option given; "rings" also on its own, as the
   // command line has always recorded it (the value given, 0 for the method's default).

@@ -107,20 +107,30 @@ TEST_F(Cli, FlowTakesANewFolderWithATrailingSlash) {
   EXPECT_TRUE(fs::exists(dir / "r" / "summary.json"));
 }
 
-TEST_F(Cli, FlowBendingNetForceRemovalIsPartOfTheRun) {
-  // The option changes the run (the spheres' Method C force loses its net force and torque), is in
-  // its identity (a resume without it is refused), and leaves the run's identity as it was when off.
-  const fs::path a = dir / "keep", b = dir / "remove";
-  CliRun r = run("flow --cells 2" + kSmallTube + " --out " + a.string());
-  ASSERT_EQ(r.status, 0) << r.err;
-  EXPECT_FALSE(nlohmann::json::parse(r.out).contains("bending_without_net_force"));
-  r = run("flow --cells 2 --bending-net-force remove" + kSmallTube + " --out " + b.string());
+TEST_F(Cli, FlowRemovesTheBendingNetForceByDefaultAndKeepsItWhenAsked) {
+  // By default the spheres' Method C force loses its net force and torque (momentum-conserving
+  // bending); --bending-net-force keep keeps them, and the run's identity says which (a resume with
+  // the other is refused). The run says which it uses.
+  const fs::path removed = dir / "remove", kept = dir / "keep";
+  CliRun r = run("flow --cells 2" + kSmallTube + " --out " + removed.string());
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_TRUE(nlohmann::json::parse(r.out).at("bending_without_net_force").get<bool>());
-  EXPECT_NE(checkpoint_positions(a), checkpoint_positions(b));
-  r = run("flow --cells 2 --resume" + kSmallTube + " --out " + b.string());
+  EXPECT_NE(r.err.find("net force and torque removed on each cell (the default"), std::string::npos) << r.err;
+  r = run("flow --cells 2 --bending-net-force remove" + kSmallTube + " --out " + (dir / "explicit").string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(checkpoint_positions(removed), checkpoint_positions(dir / "explicit"));
+  r = run("flow --cells 2 --bending-net-force keep" + kSmallTube + " --out " + kept.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_FALSE(nlohmann::json::parse(r.out).contains("bending_without_net_force"));
+  EXPECT_NE(r.err.find("net force and torque kept"), std::string::npos) << r.err;
+  EXPECT_NE(checkpoint_positions(removed), checkpoint_positions(kept));
+  r = run("flow --cells 2 --resume" + kSmallTube + " --out " + kept.string());
   EXPECT_NE(r.status, 0);
   EXPECT_NE(r.err.find("bending_without_net_force"), std::string::npos) << r.err;
+  // Without a bending force there is nothing to remove: the default asks for nothing.
+  r = run("flow --cells 2 --method none --bending-modulus 0" + kSmallTube + " --out " + (dir / "none").string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_FALSE(nlohmann::json::parse(r.out).contains("bending_without_net_force"));
 }
 
 TEST_F(Cli, FlowWarnsOfAMeshCoarserThanTheLattice) {
@@ -264,7 +274,7 @@ TEST_F(Cli, FlowShearWithOneCellIsTheShearCommandsLatticeRun) {
   ASSERT_EQ(r.status, 0) << r.err;
   r = run(fmt::format("flow --geometry shear --height 4.5 --width 4.5 --length 4.5 --dx 0.5 --shear-rate {:.17g} "
                       "--cells 1 --cell sphere --cell-radius {:.17g} --mesh mt1:80 --membrane neo-hookean "
-                      "--shear-modulus {:.17g} --bending-modulus {:.17g} --method C --t-end {:.17g} "
+                      "--shear-modulus {:.17g} --bending-modulus {:.17g} --method C --bending-net-force keep --t-end {:.17g} "
                       "--sample-every {:.17g} --snapshot-every {:.17g} --out {}",
                       gamma, radius * 1e6, G_s, kappa_b, t_end / gamma, sample / gamma, 0.15 / gamma, b.string()));
   ASSERT_EQ(r.status, 0) << r.err;

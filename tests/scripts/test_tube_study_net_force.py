@@ -104,12 +104,14 @@ def test_pries_hematocrit_inverts_the_law():
 
 def test_net_force_removed_runs_are_runs_of_their_own():
     # The twin of a methods run without its bending force's net force: its own folder, the flow
-    # option on its command, and the key in its identity only where it is set (so the plain runs
-    # made before the option still match their summaries).
+    # option on its command (the plain runs say keep: the flow command removes it by default), and
+    # the key in its identity only where it is set (so the plain runs made before the option still
+    # match their summaries).
     plain, removed = tube_study.run(10, 0.3, "C"), tube_study.run(10, 0.3, "C", net_force="remove")
     assert removed.name != plain.name and removed.name.endswith("_noNF")
     args = removed.arguments("out")
     assert args[args.index("--bending-net-force") + 1] == "remove"
-    assert "--bending-net-force" not in plain.arguments("out")
+    plain_args = plain.arguments("out")
+    assert plain_args[plain_args.index("--bending-net-force") + 1] == "keep"
     assert removed.key()["bending_without_net_force"] is True
     assert "bending_without_net_force" not in plain.key()

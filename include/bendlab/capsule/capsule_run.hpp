@@ -91,6 +91,9 @@ struct CapsuleRunOptions {
   bool writes_files = true;
   std::function<void(const CapsuleProgress&)> on_progress;
   std::function<void(const std::string&)> on_note;
+  /// Lines for on_note once the run has passed every check of its folder and checkpoint, before
+  /// its first step (what the run uses, said only of a run that goes ahead).
+  std::vector<std::string> start_notes;
 };
 
 struct CapsuleRunResult {
