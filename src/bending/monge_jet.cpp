@@ -242,7 +242,95 @@ void check_settings(const MongeJetSettings& s) {
                             s.support_points));
 }
 
+/// The weights l_j of Lap_S w at the node of `fit` (monge_jet_laplacian) for a jet of degree D on the
+/// support `support` (positions), into `weights` (one per support point).
+template <int D>
+void laplacian_weights(const MongeJetFit& fit, const Vec3& x0, std::span<const Vec3> support, bool gaussian_weights,
+                       std::vector<double>& weights) {
+  constexpr int P = unknowns_of(D);
+  using Mat = Eigen::Matrix<double, P, P>;
+  using Vec = Eigen::Matrix<double, P, 1>;
+  const int m = static_cast<int>(support.size());
+  thread_local std::vector<Vec> phi;
+  thread_local std::vector<double> w;
+  phi.resize(m);
+  w.resize(m);
+  const double inv_s = 1.0 / fit.scale;
+  Mat a = Mat::Zero();
+  for (int j = 0; j < m; ++j) {
+    const Vec3 d = support[j] - x0;
+    const double xi = d.dot(fit.t1) * inv_s, eta = d.dot(fit.t2) * inv_s;
+    std::array<double, D + 1> pu, pv;
+    pu[0] = pv[0] = 1;
+    for (int k = 1; k <= D; ++k) pu[k] = pu[k - 1] * xi, pv[k] = pv[k - 1] * eta;
+    for (int k = 1; k <= D; ++k)
+      for (int b = 0; b <= k; ++b) phi[j][monomial_index(k - b, b)] = pu[k - b] * pv[b];
+    w[j] = gaussian_weights ? std::exp(-0.5 * (xi * xi + eta * eta)) : 1.0;
+    a.noalias() += (w[j] * phi[j]) * phi[j].transpose();
+  }
+  // Lap_S w = g^ab w_ab - T (grad h . grad w) / W^2 (farutin.cpp's derivation), T = g^ab h_ab,
+  // g^-1 = I - grad h grad h^T / W^2, W^2 = 1 + |grad h|^2, with w_u = c_10 / s, w_v = c_01 / s,
+  // w_uu = 2 c_20 / s^2, w_uv = c_11 / s^2, w_vv = 2 c_02 / s^2: l . c for the coefficients c.
+  const HeightDerivatives& h = fit.derivatives;
+  const double w2 = 1 + h.u * h.u + h.v * h.v;
+  const double g11 = 1 - h.u * h.u / w2, g12 = -h.u * h.v / w2, g22 = 1 - h.v * h.v / w2;
+  const double tr = g11 * h.uu + 2 * g12 * h.uv + g22 * h.vv;
+  Vec l = Vec::Zero();
+  l[monomial_index(1, 0)] = -tr * h.u / w2 * inv_s;
+  l[monomial_index(0, 1)] = -tr * h.v / w2 * inv_s;
+  l[monomial_index(2, 0)] = 2 * g11 * inv_s * inv_s;
+  l[monomial_index(1, 1)] = 2 * g12 * inv_s * inv_s;
+  l[monomial_index(0, 2)] = 2 * g22 * inv_s * inv_s;
+  // c = M^-1 sum_j w_j phi_j (w_j - w_i): l . c = sum_j [w_j phi_j . (M^-1 l)] (w_j - w_i).
+  const Vec y = Eigen::LLT<Mat>(a).solve(l);
+  weights.resize(m);
+  for (int j = 0; j < m; ++j) weights[j] = w[j] * phi[j].dot(y);
+}
+
 }  // namespace
+
+void monge_jet_laplacian(const Topology& t, const Points& x, const MongeJetSettings& settings,
+                         const MongeJetSupports& lists, const std::vector<MongeJetFit>& fits, const Scalars& field,
+                         Scalars& out) {
+  const int n = t.num_vertices();
+  if (static_cast<int>(fits.size()) != n || field.size() != n)
+    throw Error("monge_jet_laplacian: the fits and the field must have one entry per vertex");
+  out.resize(n);
+#pragma omp parallel
+  {
+    std::vector<int> ids;
+    std::vector<Vec3> support;
+    std::vector<double> weights;
+#pragma omp for schedule(static)
+    for (int i = 0; i < n; ++i) {
+      const MongeJetFit& fit = fits[i];
+      const Vec3 x0 = x.row(i).transpose();
+      // The support of the fit: the rings' list trimmed as in monge_jet_fit, or the widened rings.
+      if (fit.rings > lists.rings_used[i]) {
+        ids = k_ring(t, i, fit.rings);
+      } else {
+        ids.assign(lists.vertices.begin() + lists.offsets[i], lists.vertices.begin() + lists.offsets[i + 1]);
+        if (settings.support_points > 0 && static_cast<int>(ids.size()) > settings.support_points) {
+          auto d2 = [&](int v) { return (x.row(v).transpose() - x0).squaredNorm(); };
+          std::nth_element(ids.begin(), ids.begin() + (settings.support_points - 1), ids.end(),
+                           [&](int a, int b) { return d2(a) < d2(b); });
+          const double cut = d2(ids[settings.support_points - 1]) * (1 + 1e-9);
+          ids.erase(std::partition(ids.begin(), ids.end(), [&](int v) { return d2(v) <= cut; }), ids.end());
+        }
+      }
+      support.resize(ids.size());
+      for (std::size_t k = 0; k < ids.size(); ++k) support[k] = x.row(ids[k]).transpose();
+      switch (settings.degree) {
+        case 4: laplacian_weights<4>(fit, x0, support, settings.gaussian_weights, weights); break;
+        case 5: laplacian_weights<5>(fit, x0, support, settings.gaussian_weights, weights); break;
+        default: laplacian_weights<6>(fit, x0, support, settings.gaussian_weights, weights); break;
+      }
+      double sum = 0;
+      for (std::size_t k = 0; k < ids.size(); ++k) sum += weights[k] * (field[ids[k]] - field[i]);
+      out[i] = sum;
+    }
+  }
+}
 
 int monge_jet_unknowns(int degree) { return unknowns_of(degree); }
 
@@ -456,6 +544,7 @@ std::unique_ptr<BendingMethod> MongeJetMethod::create(const MethodOptions& optio
   s.frame = options.at("frame") == "angle-weighted" ? MongeFrame::AngleWeighted : MongeFrame::Covariance;
   s.gaussian_weights = option_bool(options, "gaussian_weights");
   s.support_points = static_cast<int>(option_int(options, "support_points"));
+  s.laplacian = options.at("laplacian") == "field" ? MongeLaplacian::Field : MongeLaplacian::Jet;
   return std::make_unique<MongeJetMethod>(s);
 }
 
@@ -472,7 +561,10 @@ MethodInfo MongeJetMethod::info() {
                 choice_option("frame", {"covariance", "angle-weighted"}, "covariance",
                               "chart normal: smallest principal axis of the 2-ring, or the angle-weighted normal"),
                 bool_option("gaussian_weights", false,
-                            "weight the fit by exp(-r^2 / (2 s^2)), s the RMS distance of the support")},
+                            "weight the fit by exp(-r^2 / (2 s^2)), s the RMS distance of the support"),
+                choice_option("laplacian", {"jet", "field"}, "jet",
+                              "Lap H from the jet's 3rd and 4th derivatives, or the jet's Laplace-Beltrami "
+                              "operator applied to the field H")},
                {},
                &MongeJetMethod::create};
   m.capabilities.cost = "O(N)";
@@ -497,6 +589,8 @@ void MongeJetMethod::fields(const Topology& topology, const Points& x, BendingRe
     out.K[i] = fits[i].K;
     out.lapH[i] = fits[i].lapH;
   }
+  if (settings_.laplacian == MongeLaplacian::Field)
+    monge_jet_laplacian(topology, x, settings_, *supports, fits, out.H, out.lapH);
   out.area.swap(geometry.mixed_area);  // no copy; next call the arrays are reused
 }
 

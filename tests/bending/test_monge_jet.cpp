@@ -330,8 +330,12 @@ TEST(MongeJet, RegistryEntryAndOptions) {
   EXPECT_EQ(t.rings, 2);
   EXPECT_EQ(t.frame, MongeFrame::AngleWeighted);
   EXPECT_TRUE(t.gaussian_weights);
+  EXPECT_EQ(s.laplacian, MongeLaplacian::Jet);
+  EXPECT_EQ(dynamic_cast<const MongeJetMethod&>(*make_bending_method("M", {{"laplacian", "field"}})).settings().laplacian,
+            MongeLaplacian::Field);
   for (const auto& [key, bad] : {std::pair{"degree", "3"}, std::pair{"degree", "7"}, std::pair{"support_rings", "1"},
-                                 std::pair{"support_rings", "4"}, std::pair{"frame", "mwa"}, std::pair{"degree", ""}})
+                                 std::pair{"support_rings", "4"}, std::pair{"frame", "mwa"}, std::pair{"degree", ""},
+                                 std::pair{"laplacian", "cotangent"}})
     EXPECT_THROW(make_bending_method("M", {{key, bad}}), Error) << key << "=" << bad;
 }
 
@@ -458,6 +462,42 @@ TEST(MongeJet, SphereMeshesConvergeToTheSphere) {
   }
 }
 
+TEST(MongeJetLaplacian, DegreeOneSphericalHarmonicConverges) {
+  // On the unit sphere Lap_S z = -2 z (z is a spherical harmonic of degree 1): the jets' operator
+  // applied to the field z converges to it, at second order or better, with every degree.
+  for (int degree : {4, 5, 6}) {
+    MongeJetSettings settings;
+    settings.degree = degree;
+    double previous = INFINITY;
+    for (int level = 3; level <= 5; ++level) {
+      const TriMesh m = sphere_mesh(MeshFamily::MT2, level);
+      const MeshGeometry g = MeshGeometry::compute(m.topology(), m.positions());
+      const MongeJetSupports supports = MongeJetSupports::build(m.topology(), settings);
+      const std::vector<MongeJetFit> fits = monge_jet_fit(m.topology(), m.positions(), g.normal_mwa, settings, supports);
+      const Scalars z = m.positions().col(2);
+      Scalars lap;
+      monge_jet_laplacian(m.topology(), m.positions(), settings, supports, fits, z, lap);
+      const double err = (lap + 2 * z).cwiseAbs().maxCoeff();
+      EXPECT_LT(err, 0.4 * previous) << "degree " << degree << " level " << level;
+      previous = err;
+    }
+    EXPECT_LT(previous, 1e-3) << "degree " << degree;
+  }
+}
+
+TEST(MongeJetLaplacian, FieldLaplacianOfHConvergesOnTheSphere) {
+  // laplacian=field: Lap H is the jets' operator applied to H, which is 1 on the unit sphere up to
+  // the fits' error: Lap H and f fall under refinement.
+  double previous = INFINITY;
+  for (int level = 3; level <= 5; ++level) {
+    const TriMesh m = sphere_mesh(MeshFamily::MT2, level);
+    const BendingResult r = make_bending_method("M", {{"laplacian", "field"}})->compute(m.topology(), m.positions(), 1.0);
+    const double el = r.lapH.cwiseAbs().maxCoeff();
+    EXPECT_LT(el, 0.4 * previous) << "level " << level;
+    previous = el;
+  }
+}
+
 // The acceptance: the maximum error of f on the RBC converges with slope <= -1.5 over the
 // three finest meshes up to 81920 triangles, below 2e-2 of max|f| at the finest, on MT1, MT2, the
 // octahedron family (levels 5-7: 8192, 32768 and 131072 triangles) and the irregular family (jittered
@@ -475,8 +515,9 @@ TEST(MongeJet, RbcMaximumErrorOfFConvergesAtSecondOrder) {
     MethodOptions options;
   };
   std::vector<Case> cases;
-  // The default (degree 6) and the spec's degree 5.
-  for (const MethodOptions& options : {MethodOptions{}, MethodOptions{{"degree", "5"}}})
+  // The default (degree 6), the spec's degree 5, and Lap H from the jets' operator applied to H.
+  for (const MethodOptions& options :
+       {MethodOptions{}, MethodOptions{{"degree", "5"}}, MethodOptions{{"laplacian", "field"}}})
     for (const Case& c : {Case{MeshFamily::MT1, 4, Mat3::Identity(), options},
                           Case{MeshFamily::MT2, 4, Mat3::Identity(), options},
                           Case{MeshFamily::Octa, 5, Mat3::Identity(), options},
@@ -499,8 +540,9 @@ TEST(MongeJet, RbcMaximumErrorOfFConvergesAtSecondOrder) {
     }
     const double n = static_cast<double>(err.size());
     const double slope = (n * sxy - sx * sy) / (n * sxx - sx * sx);
-    const std::string degree = c.options.empty() ? "default" : c.options.at("degree");
-    std::printf("M (degree %s) max err f, %s: %.3e %.3e %.3e, slope %.2f\n", degree.c_str(),
+    std::string label;
+    for (const auto& [key, value] : c.options) label += key + "=" + value;
+    std::printf("M (%s) max err f, %s: %.3e %.3e %.3e, slope %.2f\n", label.empty() ? "defaults" : label.c_str(),
                 to_string(c.family).c_str(), err[0], err[1], err[2], slope);
     EXPECT_LE(slope, -1.5) << to_string(c.family);
     EXPECT_LT(err.back(), 2e-2) << to_string(c.family);

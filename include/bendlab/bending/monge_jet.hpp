@@ -26,6 +26,18 @@
 //    constant term, the surface passes through x_i.
 // 4. Height derivatives at the node: d^a_u d^b_v h = a! b! c_ab / s^(a+b), orders 1 to 4.
 // 5. n, H, K, Lap_S H of the graph (graph_curvature.hpp); n is turned into world coordinates.
+//    Option laplacian=field: Lap_S H is instead the jet's Laplace-Beltrami operator at the node
+//    applied to the field H of every node's jet (monge_jet_laplacian below), as E takes Lap H from
+//    a second fit to its H, but with the degree-6 jet of the same chart and support. The discrete
+//    biharmonic is then one operator applied twice (as C's cotangent Laplacian is), where the
+//    jet's own fourth derivatives are a stencil of alternating signs: on the unit sphere (1280
+//    triangles) the default's force has modes that grow (eigenvalues of dF/dx with real parts up
+//    to +200, against -2000 for the most negative) and field's none; on the RBC its maximum error
+//    of f is 3 to 9 times smaller at 81920 triangles (MT1 2.2e-5 against 2.0e-4, irregular 7.4e-4
+//    against 1.3e-3; tests/bending/test_monge_jet.cpp). On the RBC at 320 and 1280 triangles it
+//    still has growing modes where the 40-point trim leaves an ill-conditioned support, and the
+//    untrimmed rings (support_points=0) remove them (docs/results/bending_stability.md). Not yet
+//    the default: a stretched red cell does not reach equilibrium with it either (bendlab stretch).
 //
 // Why degree 6 and not the spec's 5: a degree-5 jet's 4th derivatives carry an O(h^2) truncation
 // error fed by the surface's 6th-order Taylor terms, which the symmetric supports of the regular
@@ -55,6 +67,11 @@ namespace bendlab {
 /// How the chart's normal n0 is chosen (step 1).
 enum class MongeFrame { Covariance, AngleWeighted };
 
+/// Where Lap_S H comes from (step 5): the jet's own third and fourth derivatives (Jet), or the
+/// jet's Laplace-Beltrami operator at the node applied to the field H of every node's jet (Field;
+/// monge_jet_laplacian below).
+enum class MongeLaplacian { Jet, Field };
+
 struct MongeJetSettings {
   int degree = 6;                          ///< 4, 5 or 6 (default 6: see the header comment)
   int rings = 3;                           ///< 2 or 3: the support before any widening
@@ -64,6 +81,7 @@ struct MongeJetSettings {
   /// last of them are kept (0: all). 40 is a little more than a regular vertex's 3-ring (36), so
   /// on regular meshes only the few widened supports are trimmed; see the header comment.
   int support_points = 40;
+  MongeLaplacian laplacian = MongeLaplacian::Jet;
 };
 
 /// Unknowns of a jet of this degree without constant term: (degree + 1)(degree + 2)/2 - 1.
@@ -157,6 +175,15 @@ class MongeJetWorkspace {
 void monge_jet_fit(const Topology& topology, const Points& x, const Points& mwa_normal,
                    const MongeJetSettings& settings, const MongeJetSupports& supports, MongeJetWorkspace& ws,
                    std::vector<MongeJetFit>& fits);
+
+/// Lap_S w at every node for a field w given at the nodes: at node i, the Laplace-Beltrami operator
+/// of the graph of i's fitted jet (its metric from the jet's first and second derivatives) applied
+/// to the jet of the same degree fitted by least squares, on the same chart and support, to
+/// w_j - w_i: a linear combination sum_j l_ij (w_j - w_i) over the support (the weights l_ij do not
+/// depend on w). `fits` are monge_jet_fit's for the same shape, settings and supports.
+void monge_jet_laplacian(const Topology& topology, const Points& x, const MongeJetSettings& settings,
+                         const MongeJetSupports& supports, const std::vector<MongeJetFit>& fits, const Scalars& w,
+                         Scalars& out);
 
 /// Method M.
 class MongeJetMethod : public VariationalMethod {
