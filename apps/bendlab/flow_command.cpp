@@ -151,6 +151,11 @@ const CommandRegistration flow_registration([](CLI::App& app) {
   shear_rate->excludes(rate)->excludes(force);
   cmd->add_option("--plasma-viscosity", s.units.plasma.viscosity, "Pa s")->capture_default_str();
   cmd->add_option("--plasma-density", s.units.plasma.density, "kg/m^3")->capture_default_str();
+  cmd->add_option("--time-scale", s.units.time_scale,
+                  "time scaling S >= 1: the lattice works with S times the plasma density, which in Stokes flow only "
+                  "raises the Reynolds number, so dt is S times longer and a run takes S times fewer steps; refused "
+                  "where Re would exceed 0.85, the measured bound (docs/conventions.md §6)")
+      ->capture_default_str();
   auto* hct = cmd->add_option("--hematocrit", args->hematocrit,
                               "target tube hematocrit H_T in [0, 1) (0: plain Poiseuille flow; in the shear box the "
                               "cells' volume fraction); placement reports what it reached and refuses what it cannot place");

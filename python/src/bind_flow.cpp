@@ -25,7 +25,7 @@ void bind_flow(py::module_& m) {
          const std::string& mesh, const std::string& method, const std::vector<std::string>& method_options,
          const std::optional<std::string>& bending_net_force, const std::string& membrane, double shear_modulus, double skalak_c, double bending_modulus,
          double volume_ratio, double contact_cutoff, double contact_force, double t_end, double sample_every,
-         double snapshot_every, double steady_from, double slice_width, bool resume, bool overwrite,
+         double snapshot_every, double steady_from, double slice_width, double time_scale, bool resume, bool overwrite,
          std::int64_t stop_after_steps, const py::object& progress, double progress_interval) -> py::object {
         if (geometry != "tube" && geometry != "channel" && geometry != "shear")
           throw Error(fmt::format("geometry '{}' is not tube, channel or shear", geometry));
@@ -39,6 +39,7 @@ void bind_flow(py::module_& m) {
         s.units.length_um = length;
         s.units.dx_um = dx;
         s.units.tau = tau;
+        s.units.time_scale = time_scale;
         s.units.pseudo_shear_rate = pseudo_shear_rate;
         s.units.body_force = body_force;
         s.units.shear_rate = shear_rate;
@@ -99,7 +100,7 @@ void bind_flow(py::module_& m) {
       py::arg("shear_modulus") = 5.3e-6, py::arg("skalak_c") = 10.0, py::arg("bending_modulus") = 2e-19,
       py::arg("volume_ratio") = 100.0, py::arg("contact_cutoff") = 0.0, py::arg("contact_force") = 0.0,
       py::arg("t_end") = 0.01, py::arg("sample_every") = 1e-4, py::arg("snapshot_every") = 1e-3,
-      py::arg("steady_from") = 0.5, py::arg("slice_width") = 1.0, py::arg("resume") = false,
+      py::arg("steady_from") = 0.5, py::arg("slice_width") = 1.0, py::arg("time_scale") = 1.0, py::arg("resume") = false,
       py::arg("overwrite") = false, py::arg("stop_after_steps") = 0, py::arg("progress") = py::none(),
       py::arg("progress_interval") = 2.0,
       "Runs cells in a tube (`diameter`), a slit channel or a shear box (`height`, `width`; the box driven by "

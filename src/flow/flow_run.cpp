@@ -30,6 +30,7 @@ nlohmann::json FlowRunSpec::to_json() const {
     j["height_um"] = u.height_um;
     j["width_um"] = u.width_um;
   }
+  if (u.time_scale != 1) j["time_scale"] = u.time_scale;  // absent when 1: the runs made before it keep theirs
   if (u.pseudo_shear_rate) j["pseudo_shear_rate"] = *u.pseudo_shear_rate;
   if (shear && u.shear_rate) j["shear_rate"] = *u.shear_rate;
   if (u.body_force) j["body_force"] = *u.body_force;

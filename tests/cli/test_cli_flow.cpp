@@ -84,6 +84,38 @@ TEST_F(Cli, FlowRefusesBadInputWithOneLineBeforeWork) {
   expect_refused(run(small("--t-end 8e-6", "--t-end 1e-320")), "shorter than one lattice step", out);
 }
 
+TEST_F(Cli, FlowTimeScaleIsTheDensityScaledRunAndRefusesAReynoldsNumberAboveItsBound) {
+  // --time-scale S runs the lattice with S times the density: the very run of --plasma-density S rho
+  // (its time series byte for byte), with S recorded in its identity and dt S times the unscaled.
+  const fs::path scaled = dir / "scaled", dense = dir / "dense", plain = dir / "plain";
+  CliRun r = run("flow --cells 2 --time-scale 4" + kSmallTube + " --out " + scaled.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto s = nlohmann::json::parse(r.out);
+  EXPECT_EQ(s.at("time_scale").get<double>(), 4.0);
+  EXPECT_NE(r.err.find("time scale S = 4"), std::string::npos) << r.err;
+  r = run("flow --cells 2 --plasma-density 4100" + kSmallTube + " --out " + dense.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_FALSE(nlohmann::json::parse(r.out).contains("time_scale"));
+  EXPECT_EQ(slurp(scaled / "timeseries.csv"), slurp(dense / "timeseries.csv"));
+  EXPECT_EQ(slurp(scaled / "cells.csv"), slurp(dense / "cells.csv"));
+  r = run("flow --cells 2" + kSmallTube + " --out " + plain.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto p = nlohmann::json::parse(r.out);
+  EXPECT_NEAR(s.at("dt_s").get<double>(), 4 * p.at("dt_s").get<double>(), 1e-12 * s.at("dt_s").get<double>());
+  EXPECT_NEAR(s.at("reynolds").get<double>(), 4 * p.at("reynolds").get<double>(), 1e-12);
+  // A resume must name the same S.
+  r = run("flow --cells 2 --resume" + kSmallTube + " --out " + scaled.string());
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.err.find("time_scale"), std::string::npos) << r.err;
+  // Refused: below 1, and where Re would pass its bound (here Re = 0.0043 unscaled: S = 250 gives 1.07,
+  // at Mach 0.092, under the Mach bound).
+  const fs::path out = dir / "r";
+  expect_refused(run("flow --hematocrit 0 --time-scale 0.5" + kSmallTube + " --out " + out.string()), "--time-scale 0.5",
+                 out);
+  expect_refused(run("flow --hematocrit 0 --time-scale 250" + kSmallTube + " --out " + out.string()),
+                 "--time-scale 250: the Reynolds number", out);
+}
+
 TEST_F(Cli, FlowWritesNoNonFiniteNumber) {
   // Without cells there is no cell-free layer: an empty field, not "nan".
   for (const char* cells : {"--cells 0", "--hematocrit 0"}) {

@@ -43,7 +43,7 @@ FlowUnits shear_units(FlowUnits u) {
   if (u.nz < 4) throw Error(fmt::format("--height {} um is {} dx: a shear box needs at least 4 dx between its walls", in.height_um, u.nz));
   u.section_lattice = u.nz;
   const double dx = in.dx_um * 1e-6, H = in.height_um * 1e-6;
-  u.nu = in.plasma.viscosity / in.plasma.density;
+  u.nu = in.plasma.viscosity / in.lattice_density();
   u.nu_lattice = (in.tau - 0.5) / 3.0;
   u.dt = u.nu_lattice * dx * dx / u.nu;
   u.pseudo_shear_rate = *in.shear_rate;
@@ -72,7 +72,7 @@ std::string to_string(FlowGeometry geometry) {
 
 double FlowUnits::checked_steps(double s, const std::string& option, bool below_one_step_ok) const {
   const double steps = std::ceil(s / dt - 1e-9);
-  const char* sets_dt = "set by --dx, --tau, --plasma-viscosity and --plasma-density";
+  const char* sets_dt = "set by --dx, --tau, --plasma-viscosity, --plasma-density and --time-scale";
   if (!(steps <= kMaxSteps))
     throw Error(fmt::format("{} {} s is {:.3g} lattice steps of dt = {:.4g} s ({}): more than the {:.3g} a run can "
                             "count",
@@ -84,16 +84,28 @@ double FlowUnits::checked_steps(double s, const std::string& option, bool below_
 
 double FlowUnits::to_lattice_force(double newtons) const {
   const double h = dx();
-  return newtons * dt * dt / (input.plasma.density * h * h * h * h);
+  return newtons * dt * dt / (input.lattice_density() * h * h * h * h);
 }
 double FlowUnits::to_lattice_modulus(double newtons_per_metre) const {
   const double h = dx();
-  return newtons_per_metre * dt * dt / (input.plasma.density * h * h * h);
+  return newtons_per_metre * dt * dt / (input.lattice_density() * h * h * h);
 }
 double FlowUnits::to_lattice_energy(double joules) const {
   const double h = dx();
-  return joules * dt * dt / (input.plasma.density * h * h * h * h * h);
+  return joules * dt * dt / (input.lattice_density() * h * h * h * h * h);
 }
+
+namespace {
+// A time-scaled run keeps to Stokes flow: its Reynolds number is bounded (kMaxScaledReynolds).
+void check_scaled_reynolds(const FlowUnits& u) {
+  if (u.input.time_scale > 1 && !(u.reynolds <= kMaxScaledReynolds))
+    throw Error(fmt::format("--time-scale {}: the Reynolds number {:.3g} ({:.3g} unscaled) exceeds {}, the bound within "
+                            "which time scaling was measured to leave the flow's results unchanged; lower "
+                            "--time-scale to at most {:.3g}",
+                            u.input.time_scale, u.reynolds, u.reynolds / u.input.time_scale, kMaxScaledReynolds,
+                            u.input.time_scale * kMaxScaledReynolds / u.reynolds));
+}
+}  // namespace
 
 FlowUnits flow_units(const FlowUnitsInput& in) {
   FlowUnits u;
@@ -101,11 +113,17 @@ FlowUnits flow_units(const FlowUnitsInput& in) {
   require_positive(in.dx_um, "--dx");
   require_positive(in.plasma.viscosity, "plasma viscosity");
   require_positive(in.plasma.density, "plasma density");
+  if (!(in.time_scale >= 1) || !std::isfinite(in.time_scale))
+    throw Error(fmt::format("--time-scale {} must be a finite number >= 1", in.time_scale));
   if (!(in.tau > 0.5) || !std::isfinite(in.tau)) {
     throw Error(fmt::format("--tau {} must exceed 1/2 (the lattice viscosity (tau - 1/2)/3 must be positive)", in.tau));
   }
   require_positive(in.max_mach, "maximum Mach number");
-  if (in.geometry == FlowGeometry::Shear) return shear_units(u);
+  if (in.geometry == FlowGeometry::Shear) {
+    const FlowUnits shear = shear_units(u);
+    check_scaled_reynolds(shear);
+    return shear;
+  }
   if (in.shear_rate) throw Error("--shear-rate drives the shear box (--geometry shear); a tube or a channel takes --pseudo-shear-rate or --body-force");
   if (in.pseudo_shear_rate.has_value() == in.body_force.has_value()) {
     throw Error("give the driving either as --pseudo-shear-rate (1/s) or as --body-force (N/m^3), one of them");
@@ -141,7 +159,7 @@ FlowUnits flow_units(const FlowUnitsInput& in) {
     section = in.height_um * 1e-6;
     u.section_lattice = H;
   }
-  u.nu = eta / in.plasma.density;
+  u.nu = eta / in.lattice_density();
   u.nu_lattice = (in.tau - 0.5) / 3.0;
   u.dt = u.nu_lattice * dx * dx / u.nu;
   const double shape = in.geometry == FlowGeometry::Tube ? 32.0 : 12.0;  // v = g S^2 / (shape eta)
@@ -154,7 +172,7 @@ FlowUnits flow_units(const FlowUnitsInput& in) {
     u.mean_velocity = u.body_force * section * section / (shape * eta);
     u.pseudo_shear_rate = u.mean_velocity / section;
   }
-  u.body_force_lattice = u.body_force * u.dt * u.dt / (in.plasma.density * dx);
+  u.body_force_lattice = u.body_force * u.dt * u.dt / (in.lattice_density() * dx);
   const double peak = in.geometry == FlowGeometry::Tube ? 2.0 : 1.5;
   u.max_velocity_lattice = peak * u.to_lattice_velocity(u.mean_velocity);
   u.mach = std::sqrt(3.0) * u.max_velocity_lattice;
@@ -163,7 +181,15 @@ FlowUnits flow_units(const FlowUnitsInput& in) {
     throw Error(fmt::format("Mach number {:.3g} (peak lattice velocity {:.3g}) exceeds {}: lower the driving, dx or tau",
                             u.mach, u.max_velocity_lattice, in.max_mach));
   }
+  check_scaled_reynolds(u);
   return u;
+}
+
+std::string FlowUnits::time_scale_line() const {
+  return fmt::format("time scale S = {:g}: the lattice works with rho = {:.4g} kg/m^3 (S times the plasma's), so dt is S "
+                     "times longer and Re = {:.3g} ({:.3g} unscaled, at most {} allowed); times are physical seconds",
+                     input.time_scale, input.lattice_density(), reynolds, reynolds / input.time_scale,
+                     kMaxScaledReynolds);
 }
 
 std::vector<std::string> FlowUnits::describe() const {
@@ -175,6 +201,7 @@ std::vector<std::string> FlowUnits::describe() const {
                                 input.height_um, nz, input.width_um, input.length_um, nx, ny, nz, input.dx_um));
     lines.push_back(fmt::format("plasma eta = {} Pa s, rho = {} kg/m^3 (nu = {:.4g} m^2/s); tau = {} (nu = {:.4g} dx^2/dt): dt = {:.4g} s",
                                 input.plasma.viscosity, input.plasma.density, nu, input.tau, nu_lattice, dt));
+    if (input.time_scale > 1) lines.push_back(time_scale_line());
     lines.push_back(fmt::format("driving: shear rate {:.4g} 1/s, walls moving with -+{:.4g} um/s ({:.4g} lattice)",
                                 pseudo_shear_rate, wall_velocity * 1e6, max_velocity_lattice));
     lines.push_back(fmt::format("wall lattice velocity {:.4g}, Mach {:.3g}, Reynolds gamma H^2 / (4 nu) {:.3g}",
@@ -186,6 +213,7 @@ std::vector<std::string> FlowUnits::describe() const {
                               input.length_um, nx, ny, nz, input.dx_um));
   lines.push_back(fmt::format("plasma eta = {} Pa s, rho = {} kg/m^3 (nu = {:.4g} m^2/s); tau = {} (nu = {:.4g} dx^2/dt): dt = {:.4g} s",
                               input.plasma.viscosity, input.plasma.density, nu, input.tau, nu_lattice, dt));
+  if (input.time_scale > 1) lines.push_back(time_scale_line());
   lines.push_back(fmt::format("driving: pseudo-shear rate {:.4g} 1/s, body force {:.4g} N/m^3 ({:.4g} lattice), mean velocity {:.4g} um/s",
                               pseudo_shear_rate, body_force, body_force_lattice, mean_velocity * 1e6));
   lines.push_back(fmt::format("peak lattice velocity {:.4g}, Mach {:.3g}, Reynolds {:.3g}", max_velocity_lattice, mach, reynolds));
