@@ -16,6 +16,7 @@
 #include "bendlab/elasticity/elastic_law.hpp"
 #include "bendlab/flow/bim/bim_capsule_solver.hpp"
 #include "bendlab/flow/lbm/lbm_capsule_solver.hpp"
+#include "bendlab/flow/lbm/physical_units.hpp"
 #include "bendlab/membrane/espresso_volume_force.hpp"
 #include "bendlab/integrate/cash_karp.hpp"
 #include "bendlab/integrate/rkc.hpp"
@@ -198,7 +199,11 @@ CapsuleRunResult run_shear(const ShearRunSpec& a, const ShearRunCallbacks& callb
     lo.kernel = in.kernel;
     lo.sample_every = l.sample_every;
     lo.offset = Vec3(l.offset[0], l.offset[1], l.offset[2]);
-    // LbmCapsuleSolver's reporting interval (a parallel solver takes the same steps).
+    // LbmCapsuleSolver's reporting interval (a parallel solver takes the same steps), a count the
+    // run can hold (a larger one wrapped to a row every step).
+    if (!(l.sample_every / p.shear_rate <= lbm::FlowUnits::kMaxSteps))
+      throw Error(fmt::format("--sample-every {} (gamma t) is {:.3g} lattice steps: more than the {:.3g} a run can count",
+                              l.sample_every, l.sample_every / p.shear_rate, lbm::FlowUnits::kMaxSteps));
     const auto sample_steps = std::max<std::int64_t>(1, std::llround(l.sample_every / p.shear_rate));
     if (callbacks.make_lbm_solver) {
       solver = callbacks.make_lbm_solver(membrane, lo);

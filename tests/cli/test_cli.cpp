@@ -327,6 +327,9 @@ TEST_F(Cli, ShearLbmRefusesBadLatticesBeforeWork) {
   expect_refused(run(lbm + "--kernel phi5 --out " + out.string()), "--kernel", out);
   expect_refused(run(lbm + "--rtol 1e-6 --out " + out.string()), "--rtol", out);
   expect_refused(run("shear --mesh mt1:320 --tau 1 --out " + out.string()), "--solver lbm", out);
+  // Step counts beyond what a run can count (they ran without end, or wrote a row every step).
+  expect_refused(run(lbm + "--t-end 1e30 --out " + out.string()), "--t-end 1e+30 (gamma t) is", out);
+  expect_refused(run(lbm + "--sample-every 1e30 --out " + out.string()), "--sample-every 1e+30 (gamma t) is", out);
 }
 
 TEST_F(Cli, ShearLbmWritesTheFilesOfABimRun) {

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <tuple>
 
+#include "bendlab/flow/lbm/physical_units.hpp"
+
 namespace bendlab::lbm {
 
 LatticeConfig CapsuleRunParameters::lattice_config() const {
@@ -72,7 +74,12 @@ CapsuleRunParameters capsule_run_parameters(const CapsuleRunInput& in) {
   p.kS = p.mu * p.shear_rate * R / in.G;
   p.kB = in.kB_hat * R * R * p.kS;
   p.kV = in.kV_over_kS * p.kS / R;  // kV = 100 kS in units of R (the header)
-  p.steps = static_cast<std::int64_t>(std::ceil(in.gamma_t_end / p.shear_rate));
+  const double steps = std::ceil(in.gamma_t_end / p.shear_rate);
+  if (!(steps <= FlowUnits::kMaxSteps))
+    throw Error(fmt::format("--t-end {} (gamma t) is {:.3g} lattice steps at a shear rate of {:.3g} per step: more than "
+                            "the {:.3g} a run can count",
+                            in.gamma_t_end, steps, p.shear_rate, FlowUnits::kMaxSteps));
+  p.steps = static_cast<std::int64_t>(steps);
   if (in.reynolds > 0.3) {
     p.warnings.push_back(fmt::format("Reynolds number Re = R v / nu = {} is above the paper's bound 0.3", in.reynolds));
   }
