@@ -219,16 +219,21 @@ std::span<const Vec3> gather(const Points& x, const std::vector<int>& v, std::ve
   return buffer;
 }
 
-/// Step 2's trim: the `count` points nearest to x0 and every point as near as the last of them
-/// (to 1e-9 relative); count 0 or a smaller support: unchanged.
+/// Step 2's trim of `items` (support points, or their vertex indices), `d2` an item's squared
+/// distance from the node: the `count` nearest and every item as near as the last of them (to
+/// 1e-9 relative); count 0 or a smaller support: unchanged.
+template <class Item, class SquaredDistance>
+void trim_nearest(int count, std::vector<Item>& items, SquaredDistance d2) {
+  if (count <= 0 || static_cast<int>(items.size()) <= count) return;
+  std::nth_element(items.begin(), items.begin() + (count - 1), items.end(),
+                   [&](const Item& p, const Item& q) { return d2(p) < d2(q); });
+  const double cut = d2(items[count - 1]) * (1 + 1e-9);
+  items.erase(std::partition(items.begin(), items.end(), [&](const Item& p) { return d2(p) <= cut; }), items.end());
+}
+
+/// The trim of the support's positions (monge_jet_fit).
 void trim_support(const Vec3& x0, int count, std::vector<Vec3>& support) {
-  if (count <= 0 || static_cast<int>(support.size()) <= count) return;
-  auto closer = [&](const Vec3& p, const Vec3& q) { return (p - x0).squaredNorm() < (q - x0).squaredNorm(); };
-  std::nth_element(support.begin(), support.begin() + (count - 1), support.end(), closer);
-  const double cut = (support[count - 1] - x0).squaredNorm() * (1 + 1e-9);
-  support.erase(std::partition(support.begin(), support.end(),
-                               [&](const Vec3& p) { return (p - x0).squaredNorm() <= cut; }),
-                support.end());
+  trim_nearest(count, support, [&](const Vec3& p) { return (p - x0).squaredNorm(); });
 }
 
 void check_settings(const MongeJetSettings& s) {
@@ -310,13 +315,7 @@ void monge_jet_laplacian(const Topology& t, const Points& x, const MongeJetSetti
         ids = k_ring(t, i, fit.rings);
       } else {
         ids.assign(lists.vertices.begin() + lists.offsets[i], lists.vertices.begin() + lists.offsets[i + 1]);
-        if (settings.support_points > 0 && static_cast<int>(ids.size()) > settings.support_points) {
-          auto d2 = [&](int v) { return (x.row(v).transpose() - x0).squaredNorm(); };
-          std::nth_element(ids.begin(), ids.begin() + (settings.support_points - 1), ids.end(),
-                           [&](int a, int b) { return d2(a) < d2(b); });
-          const double cut = d2(ids[settings.support_points - 1]) * (1 + 1e-9);
-          ids.erase(std::partition(ids.begin(), ids.end(), [&](int v) { return d2(v) <= cut; }), ids.end());
-        }
+        trim_nearest(settings.support_points, ids, [&](int v) { return (Vec3(x.row(v).transpose()) - x0).squaredNorm(); });
       }
       support.resize(ids.size());
       for (std::size_t k = 0; k < ids.size(); ++k) support[k] = x.row(ids[k]).transpose();
