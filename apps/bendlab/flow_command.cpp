@@ -64,8 +64,7 @@ void flow(FlowArgs& a) {
   s.cell.method_options = a.options;
   // Momentum-conserving by default (docs/conventions.md §6): the net force and torque of the
   // bending force are taken off each cell unless --bending-net-force keep.
-  const bool has_bending = s.cell.method != "none" && s.cell.bending_modulus > 0;
-  s.cell.bending_without_net_force = a.bending_net_force ? *a.bending_net_force == "remove" : has_bending;
+  s.cell.choose_bending_net_force(a.bending_net_force);
   FlowRun::check_end(s, a.t_end);
 
   // Under mpirun: the fluid in y-slabs and each cell owned by one rank; rank 0 writes the run
@@ -94,7 +93,7 @@ void flow(FlowArgs& a) {
   o.overwrite = a.overwrite;
   o.stop_after_steps = a.stop_after_steps;
   o.on_note = note;
-  if (has_bending)
+  if (s.cell.has_bending())
     o.start_notes.push_back(
         s.cell.bending_without_net_force
             ? fmt::format("bending force: Method {}'s, its net force and torque removed on each cell{}", s.cell.method,

@@ -52,15 +52,11 @@ void bind_flow(py::module_& m) {
         s.cell.mesh = mesh;
         s.cell.method = method;
         s.cell.method_options = method_options;
-        if (bending_net_force && *bending_net_force != "keep" && *bending_net_force != "remove")
-          throw Error(fmt::format("bending_net_force '{}' is not keep or remove", *bending_net_force));
         s.cell.elastic_law = membrane;
         s.cell.shear_modulus = shear_modulus;
         s.cell.skalak_c = skalak_c;
         s.cell.bending_modulus = bending_modulus;
-        // As the flow command: remove the bending force's net force and torque unless told to keep them.
-        s.cell.bending_without_net_force = bending_net_force ? *bending_net_force == "remove"
-                                                             : method != "none" && bending_modulus > 0;
+        s.cell.choose_bending_net_force(bending_net_force);  // as the flow command
         s.cell.volume_modulus_ratio = volume_ratio;
         s.contact_cutoff_um = contact_cutoff;
         s.contact_force = contact_force;

@@ -42,6 +42,12 @@ nlohmann::json CellKindSpec::to_json() const {
   return j;
 }
 
+void CellKindSpec::choose_bending_net_force(const std::optional<std::string>& choice) {
+  if (choice && *choice != "keep" && *choice != "remove")
+    throw Error(fmt::format("--bending-net-force (Python: bending_net_force) '{}' is not keep or remove", *choice));
+  bending_without_net_force = choice ? *choice == "remove" : has_bending();
+}
+
 void check_cell_kind(const CellKindSpec& s) {
   require(s.shape == "rbc" || s.shape == "sphere", fmt::format("--cell '{}' is not a cell kind (rbc, sphere)", s.shape));
   require(s.radius_um > 0 && std::isfinite(s.radius_um), fmt::format("--cell-radius {} um must be finite and positive", s.radius_um));
@@ -56,7 +62,7 @@ void check_cell_kind(const CellKindSpec& s) {
           fmt::format("volume modulus ratio {} must be finite and not negative", s.volume_modulus_ratio));
   // The bending method and its options, before any work ("none": no bending force).
   if (s.method != "none") make_bending_method(s.method, parse_options(s.method_options));
-  require(!s.bending_without_net_force || (s.method != "none" && s.bending_modulus > 0),
+  require(!s.bending_without_net_force || s.has_bending(),
           "--bending-net-force remove needs a bending force (a --method other than none and --bending-modulus > 0)");
 }
 

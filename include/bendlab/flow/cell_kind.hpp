@@ -37,6 +37,15 @@ struct CellKindSpec {
   /// Removes the bending force's net force and torque on each cell (membrane/rigid_projection.hpp).
   bool bending_without_net_force = false;
 
+  /// Sets bending_without_net_force from the choice of bendlab flow's --bending-net-force (Python's
+  /// bending_net_force): "keep", "remove", or none for the flow runs' default, remove where there is
+  /// a bending force (a method other than none and bending_modulus > 0; docs/conventions.md §6).
+  /// Throws bendlab::Error naming the option for another value. Call it after method and
+  /// bending_modulus are set.
+  void choose_bending_net_force(const std::optional<std::string>& choice);
+  /// Whether there is a bending force: a method other than none and bending_modulus > 0.
+  bool has_bending() const { return method != "none" && bending_modulus > 0; }
+
   /// The fields that make a cell kind (a run's arguments): cell, cell_radius_um, mesh,
   /// elastic_law, shear_modulus, skalak_c, bending_modulus, method, method_options,
   /// volume_modulus_ratio, and bending_without_net_force where it is set (so that the runs made
