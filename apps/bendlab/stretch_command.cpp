@@ -173,9 +173,10 @@ void stretch(StretchArgs& a) {
   const int n = kind.reference_um.num_vertices();
   const StretchMeasures& ref = run.reference_measures();
   note(fmt::format("stretch: {} {} ({} vertices, mean edge {:.3g} um), {} law, G_s = {:g} N/m, kappa_B = {:g} J, "
-                   "method {}; {} vertices pulled at each end; tolerance {:g} pN",
+                   "method {}; {} vertices pulled at each end; tolerance {:g} pN; {} relaxation",
                    kind.spec.shape, kind.spec.mesh, n, kind.mean_edge_um, kind.spec.elastic_law, kind.spec.shear_modulus,
-                   kind.spec.bending_modulus, kind.spec.method, run.right_vertices().size(), s.tolerance_pN));
+                   kind.spec.bending_modulus, kind.spec.method, run.right_vertices().size(), s.tolerance_pN,
+                   to_string(run.spec().relaxation)));
   note(fmt::format("stretch: reference shape: axial {:.4f} um, transverse {:.4f} um, area {:.4g} um^2, volume {:.4g} "
                    "um^3",
                    ref.axial_um, ref.transverse_um, ref.area_um2, ref.volume_um3));
@@ -184,7 +185,7 @@ void stretch(StretchArgs& a) {
   auto seconds = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
   std::vector<StretchPoint> points;
   std::vector<std::pair<double, std::string>> shapes;
-  nlohmann::json summary = s.to_json();
+  nlohmann::json summary = run.spec().to_json();  // the relaxation resolved from auto
   summary["command"] = "stretch";
   summary["vertices"] = n;
   summary["pulled_vertices"] = run.right_vertices().size();
@@ -241,7 +242,7 @@ const CommandRegistration stretch_registration([](CLI::App& app) {
       "stretch",
       "Optical-tweezers stretching of a red blood cell in physical units (Mills et al. 2004): a total force F pulls "
       "the --fraction of the vertices with the largest x along +x and as many with the smallest x along -x; the "
-      "equilibrium at each force (FIRE relaxation until the largest nodal residual |F_membrane + F_applied| is below "
+      "equilibrium at each force (relaxation by --relaxation until the largest nodal residual |F_membrane + F_applied| is below "
       "--tolerance, each force starting from the previous equilibrium). Writes to --out: stretch.csv (force_pN, "
       "axial_diameter_um = extent along x, transverse_diameter_um = the largest width across x, i.e. the largest "
       "distance between two vertices projected onto the y-z plane, iterations, residual_pN, area_change = A/A0 - 1, "
@@ -256,8 +257,18 @@ const CommandRegistration stretch_registration([](CLI::App& app) {
   cmd->add_option("--tolerance", s.tolerance_pN,
                   "equilibrium: the largest nodal residual |F_membrane + F_applied|, pN")
       ->capture_default_str();
-  cmd->add_option("--max-iterations", s.max_iterations, "FIRE steps per force before the run fails")
+  cmd->add_option("--max-iterations", s.max_iterations, "relaxation steps per force before the run fails")
       ->capture_default_str();
+  cmd->add_option("--relaxation", s.relaxation,
+                  "how equilibrium is sought: fire (FIRE, inertial: for forces that are an energy's gradient or "
+                  "nearly), overdamped (dx/dt = residual, as a cell in Stokes flow, with Anderson mixing: for forces "
+                  "whose Jacobians are far from symmetric), or auto: overdamped for D, ED and M, fire otherwise")
+      ->transform(CLI::CheckedTransformer(
+          std::map<std::string, StretchRelaxation>{{"auto", StretchRelaxation::Auto},
+                                                   {"fire", StretchRelaxation::Fire},
+                                                   {"overdamped", StretchRelaxation::Overdamped}},
+          CLI::ignore_case))
+      ->option_text("TEXT:{auto,fire,overdamped}=auto");
   cmd->add_option("--cell", s.cell.shape, "cell kind: rbc (eq. (15) of the paper) or sphere")
       ->check(CLI::IsMember({"rbc", "sphere"}))
       ->capture_default_str();

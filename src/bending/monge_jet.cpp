@@ -153,7 +153,8 @@ MongeJetFit fit_jet(const Vec3& x0, const Vec3& n0_in, std::span<const Vec3> sup
 
 /// Steps 3-5 at up to kJetLanes nodes side by side (monge_jet_solve.hpp): the charts and samples
 /// one node at a time, the normal equations of all of them in SIMD lanes; out[l] is node l's fit.
-void fit_lanes(std::span<const MongeJetNode> nodes, int degree, bool gaussian_weights, MongeJetFit* out) {
+void fit_lanes(std::span<const MongeJetNode> nodes, int degree, bool gaussian_weights, MongeJetFit* out,
+               std::vector<double>* stencil_weights = nullptr) {
   thread_local JetLaneSamples samples;
   const int unknowns = unknowns_of(degree);
   int count = 0;
@@ -202,13 +203,35 @@ void fit_lanes(std::span<const MongeJetNode> nodes, int degree, bool gaussian_we
       for (int j = 0; j < m; ++j) weight[j * kJetLanes] = 1.0;
     active[l] = true;
   }
-  std::array<double, unknowns_of(6) * kJetLanes> coefficients;
+  std::array<double, unknowns_of(6) * kJetLanes> coefficients, laplacian_y;
   std::array<bool, kJetLanes> determined{};
-  solve_jet_lanes(degree, samples, coefficients.data(), determined.data());
+  std::array<double, kJetLanes> inv_scale;
+  for (int l = 0; l < kJetLanes; ++l)
+    inv_scale[l] = l < static_cast<int>(nodes.size()) && active[l] ? 1.0 / out[l].scale : 1.0;
+  solve_jet_lanes(degree, samples, coefficients.data(), determined.data(),
+                  stencil_weights ? inv_scale.data() : nullptr, stencil_weights ? laplacian_y.data() : nullptr);
   for (std::size_t l = 0; l < nodes.size(); ++l) {
     if (!active[l]) continue;
-    if (determined[l]) finish_fit(out[l], degree, coefficients.data() + l, kJetLanes);
-    else out[l] = invalid_fit(out[l].points);
+    if (!determined[l]) {
+      out[l] = invalid_fit(out[l].points);
+      continue;
+    }
+    finish_fit(out[l], degree, coefficients.data() + l, kJetLanes);
+    if (!stencil_weights) continue;
+    // The operator's weight on support point j: w_j phi_j . y (solve_jet_lanes).
+    const int m = static_cast<int>(nodes[l].support.size());
+    std::vector<double>& weights = stencil_weights[l];
+    weights.resize(m);
+    for (int j = 0; j < m; ++j) {
+      const double xi = samples.xi[j * kJetLanes + l], eta = samples.eta[j * kJetLanes + l];
+      std::array<double, 7> pu, pv;
+      pu[0] = pv[0] = 1;
+      for (int k = 1; k <= degree; ++k) pu[k] = pu[k - 1] * xi, pv[k] = pv[k - 1] * eta;
+      double sum = 0;
+      for (int k = 1; k <= degree; ++k)
+        for (int b = 0; b <= k; ++b) sum += pu[k - b] * pv[b] * laplacian_y[monomial_index(k - b, b) * kJetLanes + l];
+      weights[j] = samples.weight[j * kJetLanes + l] * sum;
+    }
   }
 }
 
@@ -229,11 +252,6 @@ void trim_nearest(int count, std::vector<Item>& items, SquaredDistance d2) {
                    [&](const Item& p, const Item& q) { return d2(p) < d2(q); });
   const double cut = d2(items[count - 1]) * (1 + 1e-9);
   items.erase(std::partition(items.begin(), items.end(), [&](const Item& p) { return d2(p) <= cut; }), items.end());
-}
-
-/// The trim of the support's positions (monge_jet_fit).
-void trim_support(const Vec3& x0, int count, std::vector<Vec3>& support) {
-  trim_nearest(count, support, [&](const Vec3& p) { return (p - x0).squaredNorm(); });
 }
 
 void check_settings(const MongeJetSettings& s) {
@@ -292,6 +310,15 @@ void laplacian_weights(const MongeJetFit& fit, const Vec3& x0, std::span<const V
   for (int j = 0; j < m; ++j) weights[j] = w[j] * phi[j].dot(y);
 }
 
+void laplacian_weights(const MongeJetFit& fit, const Vec3& x0, std::span<const Vec3> support, int degree,
+                       bool gaussian_weights, std::vector<double>& weights) {
+  switch (degree) {
+    case 4: return laplacian_weights<4>(fit, x0, support, gaussian_weights, weights);
+    case 5: return laplacian_weights<5>(fit, x0, support, gaussian_weights, weights);
+    default: return laplacian_weights<6>(fit, x0, support, gaussian_weights, weights);
+  }
+}
+
 }  // namespace
 
 void monge_jet_laplacian(const Topology& t, const Points& x, const MongeJetSettings& settings,
@@ -319,11 +346,7 @@ void monge_jet_laplacian(const Topology& t, const Points& x, const MongeJetSetti
       }
       support.resize(ids.size());
       for (std::size_t k = 0; k < ids.size(); ++k) support[k] = x.row(ids[k]).transpose();
-      switch (settings.degree) {
-        case 4: laplacian_weights<4>(fit, x0, support, settings.gaussian_weights, weights); break;
-        case 5: laplacian_weights<5>(fit, x0, support, settings.gaussian_weights, weights); break;
-        default: laplacian_weights<6>(fit, x0, support, settings.gaussian_weights, weights); break;
-      }
+      laplacian_weights(fit, x0, support, settings.degree, settings.gaussian_weights, weights);
       double sum = 0;
       for (std::size_t k = 0; k < ids.size(); ++k) sum += weights[k] * (field[ids[k]] - field[i]);
       out[i] = sum;
@@ -429,6 +452,7 @@ struct MongeJetWorkspace::Thread {
   VertexRings nb;
   std::vector<Vec3> buffer;
   std::array<std::vector<Vec3>, kJetLanes> supports;
+  std::array<std::vector<int>, kJetLanes> ids;  // the supports' vertices
   std::array<MongeJetNode, kJetLanes> nodes;
 };
 
@@ -446,13 +470,32 @@ MongeJetWorkspace::Thread& MongeJetWorkspace::thread(int k, const Topology& topo
   return *slot;
 }
 
+void MongeJetLaplacianStencil::apply(const Scalars& w, Scalars& out) const {
+  const auto n = static_cast<Eigen::Index>(ids.size());
+  if (w.size() != n || static_cast<Eigen::Index>(weights.size()) != n)
+    throw Error("Method M's Laplacian stencil: the field must have one entry per vertex of the stencil");
+  out.resize(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const std::vector<int>& id = ids[i];
+    const std::vector<double>& c = weights[i];
+    double sum = 0;
+    for (std::size_t k = 0; k < id.size(); ++k) sum += c[k] * (w[id[k]] - w[i]);
+    out[i] = sum;
+  }
+}
+
 void monge_jet_fit(const Topology& t, const Points& x, const Points& mwa_normal, const MongeJetSettings& settings,
-                   const MongeJetSupports& lists, MongeJetWorkspace& ws, std::vector<MongeJetFit>& fits) {
+                   const MongeJetSupports& lists, MongeJetWorkspace& ws, std::vector<MongeJetFit>& fits,
+                   MongeJetLaplacianStencil* stencil) {
   check_settings(settings);
   if (!lists.matches(t, settings))
     throw Error("method M: the support lists were built for another mesh connectivity or other options");
   const int n = t.num_vertices();
   fits.resize(n);
+  if (stencil) {
+    stencil->ids.resize(n);
+    stencil->weights.resize(n);
+  }
   // kJetLanes nodes at a time: their supports one by one, their fits side by side (fit_lanes).
   const int batches = (n + kJetLanes - 1) / kJetLanes;
   ws.prepare();
@@ -462,6 +505,7 @@ void monge_jet_fit(const Topology& t, const Points& x, const Points& mwa_normal,
     VertexRings& nb = scratch.nb;
     std::vector<Vec3>& buffer = scratch.buffer;
     std::array<std::vector<Vec3>, kJetLanes>& supports = scratch.supports;
+    std::array<std::vector<int>, kJetLanes>& ids = scratch.ids;
     std::array<MongeJetNode, kJetLanes>& nodes = scratch.nodes;
 #pragma omp for schedule(static)
     for (int b = 0; b < batches; ++b) {
@@ -469,18 +513,23 @@ void monge_jet_fit(const Topology& t, const Points& x, const Points& mwa_normal,
       for (int l = 0; l < count; ++l) {
         // The support of step 2 (rings listed ring after ring, so the frame's 2-ring is a prefix).
         const int i = first + l;
+        std::vector<int>& id = ids[l];
+        id.assign(lists.vertices.begin() + lists.offsets[i], lists.vertices.begin() + lists.offsets[i + 1]);
         std::vector<Vec3>& support = supports[l];
-        support.resize(lists.offsets[i + 1] - lists.offsets[i]);
-        for (std::size_t k = 0; k < support.size(); ++k) support[k] = x.row(lists.vertices[lists.offsets[i] + k]).transpose();
+        gather(x, id, support);
         const Vec3 x0 = x.row(i).transpose(), mwa = mwa_normal.row(i).transpose();
         const Vec3 n0 = settings.frame == MongeFrame::AngleWeighted
                             ? mwa
                             : covariance_normal(x0, std::span<const Vec3>(support).first(lists.two_ring[i]), mwa);
-        trim_support(x0, settings.support_points, support);
+        if (settings.support_points > 0 && static_cast<int>(id.size()) > settings.support_points) {
+          trim_nearest(settings.support_points, id,
+                       [&](int v) { return (Vec3(x.row(v).transpose()) - x0).squaredNorm(); });
+          gather(x, id, support);
+        }
         nodes[l] = MongeJetNode{x0, n0, support};
       }
       fit_lanes(std::span<const MongeJetNode>(nodes.data(), count), settings.degree, settings.gaussian_weights,
-                fits.data() + first);
+                fits.data() + first, stencil ? stencil->weights.data() + first : nullptr);
       for (int l = 0; l < count; ++l) {
         const int i = first + l;
         MongeJetFit& fit = fits[i];
@@ -493,8 +542,14 @@ void monge_jet_fit(const Topology& t, const Points& x, const Points& mwa_normal,
             fit = monge_jet_fit_point(nodes[l].x0, nodes[l].n0, gather(x, nb.vertices(), buffer), settings.degree,
                                       settings.gaussian_weights);
           rings = nb.rings();
+          if (stencil && fit.valid) {
+            ids[l] = nb.vertices();
+            laplacian_weights(fit, nodes[l].x0, buffer, settings.degree, settings.gaussian_weights,
+                              stencil->weights[i]);
+          }
         }
         fit.rings = rings;
+        if (stencil) stencil->ids[i] = ids[l];
       }
     }
   }
@@ -517,6 +572,7 @@ struct MongeJetMethod::Workspace {
   MeshGeometry geometry;
   std::vector<MongeJetFit> fits;
   MongeJetWorkspace buffers;
+  MongeJetLaplacianStencil stencil;  // laplacian = field
 };
 
 MongeJetMethod::MongeJetMethod(MongeJetSettings settings) : settings_(settings) { check_settings(settings_); }
@@ -549,19 +605,20 @@ std::unique_ptr<BendingMethod> MongeJetMethod::create(const MethodOptions& optio
 
 MethodInfo MongeJetMethod::info() {
   MethodInfo m{"M",
-               "Monge jet: degree-6 height fit on the 3-ring gives n, H, K and Lap H in eq. (10) (beyond the paper)",
+               "Monge jet: degree-6 height fits on the 3-ring give n, H and K, and their Laplace-Beltrami operator applied to H "
+               "gives Lap H, in eq. (10) (beyond the paper)",
                {int_option("degree", 4, 6, 6, "degree of the fitted height polynomial (4, 5 or 6)"),
                 int_option("support_rings", 2, 3, 3,
                            "fitting support in rings of neighbours (widened while it has fewer than "
                            "unknowns + 4 points or the fit is singular)"),
-                int_option("support_points", 0, 1000, 40,
+                int_option("support_points", 0, 1000, 0,
                            "keep the nearest this many points of the rings, and any as near as the last "
                            "(0: all; else at least unknowns + 4)"),
                 choice_option("frame", {"covariance", "angle-weighted"}, "covariance",
                               "chart normal: smallest principal axis of the 2-ring, or the angle-weighted normal"),
                 bool_option("gaussian_weights", false,
                             "weight the fit by exp(-r^2 / (2 s^2)), s the RMS distance of the support"),
-                choice_option("laplacian", {"jet", "field"}, "jet",
+                choice_option("laplacian", {"jet", "field"}, "field",
                               "Lap H from the jet's 3rd and 4th derivatives, or the jet's Laplace-Beltrami "
                               "operator applied to the field H")},
                {},
@@ -575,7 +632,9 @@ void MongeJetMethod::fields(const Topology& topology, const Points& x, BendingRe
   const auto ws = workspace_.acquire();
   MeshGeometry& geometry = ws->geometry;
   MeshGeometry::compute(topology, x, geometry);
-  monge_jet_fit(topology, x, geometry.normal_mwa, settings_, *supports, ws->buffers, ws->fits);
+  const bool field = settings_.laplacian == MongeLaplacian::Field;
+  monge_jet_fit(topology, x, geometry.normal_mwa, settings_, *supports, ws->buffers, ws->fits,
+                field ? &ws->stencil : nullptr);
   const std::vector<MongeJetFit>& fits = ws->fits;
   const auto n = static_cast<Eigen::Index>(fits.size());
   out.normal.resize(n, 3);
@@ -588,8 +647,7 @@ void MongeJetMethod::fields(const Topology& topology, const Points& x, BendingRe
     out.K[i] = fits[i].K;
     out.lapH[i] = fits[i].lapH;
   }
-  if (settings_.laplacian == MongeLaplacian::Field)
-    monge_jet_laplacian(topology, x, settings_, *supports, fits, out.H, out.lapH);
+  if (field) ws->stencil.apply(out.H, out.lapH);
   out.area.swap(geometry.mixed_area);  // no copy; next call the arrays are reused
 }
 

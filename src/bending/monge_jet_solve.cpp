@@ -36,9 +36,12 @@ struct Basis {
   }
 };
 
+constexpr int monomial_index(int a, int b) { return (a + b - 1) * (a + b + 2) / 2 + b; }
+
 template <int D>
 __attribute__((always_inline)) inline void solve_body(const double* xi, const double* eta, const double* h,
-                                                      const double* w, int m, double* coef, bool* determined) {
+                                                      const double* w, int m, double* coef, bool* determined,
+                                                      const double* inv_scale, double* laplacian_y) {
   constexpr int P = unknowns_of(D), Q = 2 * D + 1;
   constexpr Basis<D> basis;
   alignas(64) double mu[Q][Q][L] = {};  // mu[p][q] = sum w xi^p eta^q, p + q <= 2D
@@ -99,29 +102,55 @@ __attribute__((always_inline)) inline void solve_body(const double* xi, const do
         for (int l = 0; l < L; ++l) cc[i][l] -= ck[c - k + i][l] * lck[l];
     }
   }
-  // L y = rhs by columns; then L^T c = y by dot products down each column (two partial sums).
-  for (int k = 0; k < P; ++k) {
-    alignas(64) double yk[L];
-    for (int l = 0; l < L; ++l) yk[l] = rhs[k][l] *= inv_diag[k][l];
-    const double(*ck)[L] = a + col[k];
-    for (int i = 1; i < P - k; ++i)
-      for (int l = 0; l < L; ++l) rhs[k + i][l] -= ck[i][l] * yk[l];
-  }
-  for (int r = P - 1; r >= 0; --r) {
-    const double(*cr)[L] = a + col[r];  // cr[i] = L_(r+i) r
-    alignas(64) double s0[L], s1[L];
-    for (int l = 0; l < L; ++l) s0[l] = rhs[r][l], s1[l] = 0.0;
-    int i = 1;
-    for (; i + 1 < P - r; i += 2)
-      for (int l = 0; l < L; ++l) {
-        s0[l] -= cr[i][l] * coef[(r + i) * L + l];
-        s1[l] -= cr[i + 1][l] * coef[(r + i + 1) * L + l];
-      }
-    for (; i < P - r; ++i)
-      for (int l = 0; l < L; ++l) s0[l] -= cr[i][l] * coef[(r + i) * L + l];
-    for (int l = 0; l < L; ++l) coef[r * L + l] = (s0[l] + s1[l]) * inv_diag[r][l];
-  }
+  // M x = b with the factor: L y = b by columns (b overwritten by y); then L^T x = y by dot
+  // products down each column (two partial sums).
+  const auto solve = [&](double(*b)[L], double* x) __attribute__((always_inline)) {
+    for (int k = 0; k < P; ++k) {
+      alignas(64) double yk[L];
+      for (int l = 0; l < L; ++l) yk[l] = b[k][l] *= inv_diag[k][l];
+      const double(*ck)[L] = a + col[k];
+      for (int i = 1; i < P - k; ++i)
+        for (int l = 0; l < L; ++l) b[k + i][l] -= ck[i][l] * yk[l];
+    }
+    for (int r = P - 1; r >= 0; --r) {
+      const double(*cr)[L] = a + col[r];  // cr[i] = L_(r+i) r
+      alignas(64) double s0[L], s1[L];
+      for (int l = 0; l < L; ++l) s0[l] = b[r][l], s1[l] = 0.0;
+      int i = 1;
+      for (; i + 1 < P - r; i += 2)
+        for (int l = 0; l < L; ++l) {
+          s0[l] -= cr[i][l] * x[(r + i) * L + l];
+          s1[l] -= cr[i + 1][l] * x[(r + i + 1) * L + l];
+        }
+      for (; i < P - r; ++i)
+        for (int l = 0; l < L; ++l) s0[l] -= cr[i][l] * x[(r + i) * L + l];
+      for (int l = 0; l < L; ++l) x[r * L + l] = (s0[l] + s1[l]) * inv_diag[r][l];
+    }
+  };
+  solve(rhs, coef);
   for (int l = 0; l < L; ++l) determined[l] = min_pivot[l] > kJetMinPivotRatio * max_diag[l];
+  if (laplacian_y == nullptr) return;
+  // The Laplace-Beltrami operator of the fitted graph at the node applied to a field's jet of the
+  // same basis, l . c (monge_jet_laplacian's derivation): Lap_S f = g^ab f_ab - T (grad h . grad f)
+  // / W^2, T = g^ab h_ab, g^-1 = I - grad h grad h^T / W^2, W^2 = 1 + |grad h|^2, with the height's
+  // derivatives h_u = c_10 / s, h_uu = 2 c_20 / s^2, h_uv = c_11 / s^2 from this lane's fit. Then
+  // y = M^-1 l, so that the weight of sample j is w_j phi_j . y.
+  alignas(64) double lv[P][L] = {};
+  for (int l = 0; l < L; ++l) {
+    const double is = inv_scale[l], is2 = is * is;
+    const double hu = coef[monomial_index(1, 0) * L + l] * is, hv = coef[monomial_index(0, 1) * L + l] * is;
+    const double huu = 2 * coef[monomial_index(2, 0) * L + l] * is2, huv = coef[monomial_index(1, 1) * L + l] * is2,
+                 hvv = 2 * coef[monomial_index(0, 2) * L + l] * is2;
+    const double w2 = 1 + hu * hu + hv * hv;
+    const double g11 = 1 - hu * hu / w2, g12 = -hu * hv / w2, g22 = 1 - hv * hv / w2;
+    const double tr = g11 * huu + 2 * g12 * huv + g22 * hvv;
+    lv[monomial_index(1, 0)][l] = -tr * hu / w2 * is;
+    lv[monomial_index(0, 1)][l] = -tr * hv / w2 * is;
+    lv[monomial_index(2, 0)][l] = 2 * g11 * is2;
+    lv[monomial_index(1, 1)][l] = 2 * g12 * is2;
+    lv[monomial_index(0, 2)][l] = 2 * g22 * is2;
+  }
+  solve(lv, laplacian_y);
 }
 
 // Compiled for AVX-512, AVX2+FMA and baseline x86-64 and picked at run time (as belkin_kernel.cpp's and
@@ -133,8 +162,9 @@ __attribute__((always_inline)) inline void solve_body(const double* xi, const do
 #endif
 #define BENDLAB_JET_KERNEL(D)                                                                              \
   BENDLAB_JET_CLONES void solve_lanes##D(const double* xi, const double* eta, const double* h, const double* w, \
-                                         int m, double* coef, bool* determined) {                          \
-    solve_body<D>(xi, eta, h, w, m, coef, determined);                                                    \
+                                         int m, double* coef, bool* determined, const double* inv_scale,   \
+                                         double* laplacian_y) {                                            \
+    solve_body<D>(xi, eta, h, w, m, coef, determined, inv_scale, laplacian_y);                            \
   }
 BENDLAB_JET_KERNEL(4)
 BENDLAB_JET_KERNEL(5)
@@ -143,7 +173,10 @@ BENDLAB_JET_KERNEL(6)
 
 }  // namespace
 
-void solve_jet_lanes(int degree, const JetLaneSamples& s, double* coefficients, bool* determined) {
+void solve_jet_lanes(int degree, const JetLaneSamples& s, double* coefficients, bool* determined,
+                     const double* inv_scale, double* laplacian_y) {
+  if ((inv_scale == nullptr) != (laplacian_y == nullptr))
+    throw Error("solve_jet_lanes: the Laplacian needs both the inverse scales and room for y");
   const auto size = static_cast<std::size_t>(s.count) * L;
   if (s.count < 0 || s.xi.size() != size || s.eta.size() != size || s.height.size() != size ||
       s.weight.size() != size)
@@ -153,9 +186,9 @@ void solve_jet_lanes(int degree, const JetLaneSamples& s, double* coefficients, 
   const double* h = s.height.data();
   const double* w = s.weight.data();
   switch (degree) {
-    case 4: return solve_lanes4(x, e, h, w, s.count, coefficients, determined);
-    case 5: return solve_lanes5(x, e, h, w, s.count, coefficients, determined);
-    case 6: return solve_lanes6(x, e, h, w, s.count, coefficients, determined);
+    case 4: return solve_lanes4(x, e, h, w, s.count, coefficients, determined, inv_scale, laplacian_y);
+    case 5: return solve_lanes5(x, e, h, w, s.count, coefficients, determined, inv_scale, laplacian_y);
+    case 6: return solve_lanes6(x, e, h, w, s.count, coefficients, determined, inv_scale, laplacian_y);
     default: throw Error(fmt::format("method M: degree must be 4, 5 or 6, got {}", degree));
   }
 }

@@ -8,6 +8,7 @@
 #include <numeric>
 
 #include "bendlab/geometry/measures.hpp"
+#include "bendlab/integrate/anderson_mixing.hpp"
 
 namespace bendlab {
 
@@ -18,6 +19,7 @@ void require(bool ok, const std::string& message) {
 }
 
 constexpr int kMaxRestarts = 8;
+constexpr int kAndersonDepth = 10;  // Walker & Ni's range is 1-10; deeper kept no step off at 1280 triangles
 
 // The largest row length, without the overflow of a squared norm (a force of 1e308 pN has a
 // length, not an infinite one).
@@ -32,6 +34,19 @@ double max_row_norm(const Points& a) {
 
 }  // namespace
 
+StretchRelaxation default_relaxation(const std::string& method) {
+  // The methods whose linearised force is far from symmetric (docs/results/bending_stability.md).
+  return method == "D" || method == "ED" || method == "M" ? StretchRelaxation::Overdamped : StretchRelaxation::Fire;
+}
+
+std::string to_string(StretchRelaxation r) {
+  switch (r) {
+    case StretchRelaxation::Fire: return "fire";
+    case StretchRelaxation::Overdamped: return "overdamped";
+    default: return "auto";
+  }
+}
+
 nlohmann::json StretchSpec::to_json() const {
   const FireParameters& f = fire;
   nlohmann::json j = cell.to_json();
@@ -39,6 +54,7 @@ nlohmann::json StretchSpec::to_json() const {
                               {"fraction", fraction},
                               {"tolerance_pN", tolerance_pN},
                               {"max_iterations", max_iterations},
+                              {"relaxation", to_string(relaxation)},
                               {"fire",
                                {{"n_min", f.n_min},
             {"f_inc", f.f_inc},
@@ -129,6 +145,8 @@ OpticalStretch::OpticalStretch(StretchSpec spec)
     : spec_(checked(std::move(spec))),
       kind_(make_cell_kind(spec_.cell)),
       membrane_(physical_membrane(kind_)) {
+  if (spec_.relaxation == StretchRelaxation::Auto)
+    spec_.relaxation = default_relaxation(spec_.cell.bending_modulus > 0 ? spec_.cell.method : "none");
   const Points& ref = kind_.reference_um.positions();
   const int n_vertices = static_cast<int>(ref.rows());
   const int n = pulled_vertex_count(spec_.fraction, n_vertices);
@@ -220,12 +238,31 @@ StretchPoint OpticalStretch::equilibrate(double force_pN, const std::function<vo
     const double max_step = fp.max_step_edges * mean_edge_um_;
     Points v = Points::Zero(n, 3), step(n, 3);
     double dt = fp.dt_start_fraction * dt_max, alpha = fp.alpha_start;
+    double over_dt = fp.dt_max_factor / p.lambda_max;
+    AndersonMixing mixing(kAndersonDepth);
+    Eigen::VectorXd plain, flat, accelerated;
+    double best_since_reset = residual;
     int positive = 0;
     long next_report = 20000;
     // A relaxation that overshoots may raise the residual for a while, never by orders of
     // magnitude: beyond this it diverges.
     const double blow_up = 1e3 * std::max(residual, spec_.tolerance_pN);
     while (residual >= spec_.tolerance_pN && it < spec_.max_iterations) {
+      if (spec_.relaxation == StretchRelaxation::Overdamped) {
+        // dx/dt = R by forward Euler: stable for dt |mu| < 2 on every eigenvalue mu of the
+        // Jacobian with a negative real part; dt = dt_max_factor / lambda_max leaves a factor two.
+        // Anderson mixing of the last steps (anderson_mixing.hpp) turns it into a GMRES-like solve;
+        // a residual that has grown tenfold from the best since the last reset clears the history.
+        if (residual > 10 * best_since_reset) {
+          mixing.reset();
+          best_since_reset = residual;
+        }
+        best_since_reset = std::min(best_since_reset, residual);
+        plain = Eigen::Map<const Eigen::VectorXd>(r.data(), r.size()) * over_dt;
+        flat = Eigen::Map<const Eigen::VectorXd>(x_.data(), x_.size());
+        mixing.step(flat, plain, accelerated);
+        step = Eigen::Map<const Points>(accelerated.data(), n, 3);
+      } else {
       // FIRE (Bitzek et al. 2006): P = F.v decides whether to keep going downhill faster (mix the
       // velocity towards the force, grow dt) or to stop (v = 0, cut dt). v = 0 (the start, a
       // reset) has P = 0 and changes nothing.
@@ -246,6 +283,7 @@ StretchPoint OpticalStretch::equilibrate(double force_pN, const std::function<vo
       // Semi-implicit Euler with unit masses; the step bounded per vertex.
       v += dt * r;
       step = dt * v;
+      }
       const double largest = max_row_norm(step);
       if (largest > max_step) {
         const double s = max_step / largest;
@@ -274,10 +312,13 @@ StretchPoint OpticalStretch::equilibrate(double force_pN, const std::function<vo
         }
         v.setZero();
         dt_max *= 0.5;
+        over_dt *= 0.5;
+        mixing.reset();
         dt = fp.dt_start_fraction * dt_max;
         alpha = fp.alpha_start;
         positive = 0;
         residual = evaluate();
+        best_since_reset = residual;
       }
       if (progress && it >= next_report) {
         progress(fmt::format("  F = {:g} pN: {} iterations, residual {:.3g} pN", force_pN, it, residual));

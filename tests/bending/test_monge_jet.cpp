@@ -330,9 +330,10 @@ TEST(MongeJet, RegistryEntryAndOptions) {
   EXPECT_EQ(t.rings, 2);
   EXPECT_EQ(t.frame, MongeFrame::AngleWeighted);
   EXPECT_TRUE(t.gaussian_weights);
-  EXPECT_EQ(s.laplacian, MongeLaplacian::Jet);
-  EXPECT_EQ(dynamic_cast<const MongeJetMethod&>(*make_bending_method("M", {{"laplacian", "field"}})).settings().laplacian,
-            MongeLaplacian::Field);
+  EXPECT_EQ(s.laplacian, MongeLaplacian::Field);
+  EXPECT_EQ(s.support_points, 0);
+  EXPECT_EQ(dynamic_cast<const MongeJetMethod&>(*make_bending_method("M", {{"laplacian", "jet"}})).settings().laplacian,
+            MongeLaplacian::Jet);
   for (const auto& [key, bad] : {std::pair{"degree", "3"}, std::pair{"degree", "7"}, std::pair{"support_rings", "1"},
                                  std::pair{"support_rings", "4"}, std::pair{"frame", "mwa"}, std::pair{"degree", ""},
                                  std::pair{"laplacian", "cotangent"}})
@@ -421,7 +422,8 @@ TEST(MongeJet, SupportTrimKeepsRegularThreeRingsWhole) {
   // 4 rings, are trimmed and change. Counts below unknowns + 4 are refused.
   const TriMesh sphere = sphere_mesh(MeshFamily::MT1, 3);  // 1280 triangles
   const TriMesh m = sphere.with_positions(make_rbc()->map_from_unit_sphere(sphere.positions()));
-  const BendingResult trimmed = make_bending_method("M")->compute(m.topology(), m.positions(), 1.0);
+  const BendingResult trimmed =
+      make_bending_method("M", {{"support_points", "40"}})->compute(m.topology(), m.positions(), 1.0);
   const BendingResult whole =
       make_bending_method("M", {{"support_points", "0"}})->compute(m.topology(), m.positions(), 1.0);
   int same = 0, changed_irregular = 0;
@@ -485,6 +487,40 @@ TEST(MongeJetLaplacian, DegreeOneSphericalHarmonicConverges) {
   }
 }
 
+TEST(MongeJetLaplacian, StencilFromTheFitsEqualsTheReference) {
+  // The fast path (the stencil's weights from the fits' own factors, solve_jet_lanes) against the
+  // reference (monge_jet_laplacian: each node's normal matrix summed and factored again): the same
+  // operator up to round-off, for every degree, with and without the trim and the Gaussian weights,
+  // on the RBC of the irregular family (jittered: no two supports alike).
+  const TriMesh sphere = sphere_mesh(MeshFamily::Irregular, 3);
+  const TriMesh m = sphere.with_positions(make_rbc()->map_from_unit_sphere(sphere.positions()));
+  const MeshGeometry g = MeshGeometry::compute(m.topology(), m.positions());
+  const Scalars w = m.positions().col(0).array() * m.positions().col(2).array() + m.positions().col(1).array();
+  for (int degree : {4, 5, 6})
+    for (int trim : {0, 40})
+      for (bool gaussian : {false, true}) {
+        MongeJetSettings settings;
+        settings.degree = degree;
+        settings.support_points = trim;
+        settings.gaussian_weights = gaussian;
+        const MongeJetSupports supports = MongeJetSupports::build(m.topology(), settings);
+        MongeJetWorkspace ws;
+        std::vector<MongeJetFit> fits;
+        MongeJetLaplacianStencil stencil;
+        monge_jet_fit(m.topology(), m.positions(), g.normal_mwa, settings, supports, ws, fits, &stencil);
+        Scalars fast, reference;
+        stencil.apply(w, fast);
+        monge_jet_laplacian(m.topology(), m.positions(), settings, supports, fits, w, reference);
+        const double scale = reference.cwiseAbs().maxCoeff();
+        EXPECT_LT((fast - reference).cwiseAbs().maxCoeff(), 1e-9 * scale)
+            << "degree " << degree << " trim " << trim << " gaussian " << gaussian;
+        // The fits themselves are those without the stencil, bit for bit.
+        std::vector<MongeJetFit> plain;
+        monge_jet_fit(m.topology(), m.positions(), g.normal_mwa, settings, supports, ws, plain);
+        for (int i = 0; i < m.num_vertices(); ++i) ASSERT_EQ(plain[i].H, fits[i].H) << i;
+      }
+}
+
 TEST(MongeJetLaplacian, FieldLaplacianOfHConvergesOnTheSphere) {
   // laplacian=field: Lap H is the jets' operator applied to H, which is 1 on the unit sphere up to
   // the fits' error: Lap H and f fall under refinement.
@@ -515,9 +551,10 @@ TEST(MongeJet, RbcMaximumErrorOfFConvergesAtSecondOrder) {
     MethodOptions options;
   };
   std::vector<Case> cases;
-  // The default (degree 6), the spec's degree 5, and Lap H from the jets' operator applied to H.
-  for (const MethodOptions& options :
-       {MethodOptions{}, MethodOptions{{"degree", "5"}}, MethodOptions{{"laplacian", "field"}}})
+  // The defaults (degree 6, Lap H from the jets' operator applied to H, whole rings), the spec's
+  // degree 5, and the former defaults (Lap H from the jet's own derivatives, the 40-point trim).
+  for (const MethodOptions& options : {MethodOptions{}, MethodOptions{{"degree", "5"}, {"laplacian", "jet"}},
+                                       MethodOptions{{"laplacian", "jet"}, {"support_points", "40"}}})
     for (const Case& c : {Case{MeshFamily::MT1, 4, Mat3::Identity(), options},
                           Case{MeshFamily::MT2, 4, Mat3::Identity(), options},
                           Case{MeshFamily::Octa, 5, Mat3::Identity(), options},

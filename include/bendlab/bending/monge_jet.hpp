@@ -1,43 +1,46 @@
 #pragma once
 // Method M (Monge jet; ../shared/spec/METHOD_M.md): at every node a least-squares height function
-// of degree 6 (default; 4 and 5 as options) over the vertices within 3 edge-rings gives the normal, H, K and Lap_S H of
-// the fitted graph (graph_curvature.hpp), and then the force density of eq. (10),
+// of degree 6 (default; 4 and 5 as options) over the vertices within 3 edge-rings gives the normal, H
+// and K of the fitted graph (graph_curvature.hpp); Lap_S H is the jets' Laplace-Beltrami operator
+// applied to the field H (step 5); then the force density of eq. (10),
 //   f = 2 kB (Lap H + 2 H (H^2 - K)) n,    F = f A_mixed (eq. (14)), as for C and E.
-// Unlike E, which fits a paraboloid and then a second paraboloid to the fitted H, M takes Lap H from
-// the same jet (its 3rd and 4th derivatives), so the O(h^2) noise of H is never differentiated twice:
-// its maximum errors of Lap H and f converge at second order on irregular meshes too.
 //
 // Per vertex i:
 // 1. Frame: n0 = the eigenvector of the smallest eigenvalue of sum_j (x_j - x_i)(x_j - x_i)^T over
 //    the 2-ring of i, signed to agree with the angle-weighted (MWA) normal; option frame =
 //    angle-weighted takes the MWA normal itself. t1, t2 complete a right-handed frame.
-// 2. Support: the vertices within `rings` edge-rings (i excluded; option support_rings), widened ring by ring while it has
-//    fewer than monge_jet_min_points(degree) points (24 for degree 5) or while the fit is singular;
-//    then trimmed to the support_points (default 40) nearest to x_i, with every point as near as the
-//    last one kept (no arbitrary choice among equidistant points). Rings count edges, not
-//    distance: where the mesh is graded (Rivara refinement) or a vertex has valence 8-10, the
-//    3-ring holds 50 and more points and reaches farther on the coarse side, and the jet's
-//    truncation error grows with the support's radius; the trim gives every node about the radius
-//    of a regular 3-ring. On the Rivara meshes of table 3 it took r_max of f from 2.6 (MT2) and
-//    2.4 (MT1) to about 1.1-1.2; r_max stays below 1.6 for any count from 37 to 44, and 33 is too
-//    few (docs/results/rbc.md, table 3).
+// 2. Support: the vertices within `rings` edge-rings (i excluded; option support_rings), widened ring
+//    by ring while it has fewer than monge_jet_min_points(degree) points (31 for degree 6) or while
+//    the fit is singular. The support depends on the connectivity only, so the force is a smooth
+//    function of the positions. Option support_points = k trims it to the k nearest to x_i (with
+//    every point as near as the last one kept): where the mesh is graded (Rivara refinement) or a
+//    vertex has valence 8-10, the 3-ring holds 50 and more points and reaches farther on the coarse
+//    side, and k = 40 took r_max of f on the Rivara meshes of table 3 from 2.6 (MT2) and 2.4 (MT1) to
+//    about 1.1-1.2 (docs/results/rbc.md). But the nearest-k rule makes the force jump as points
+//    trade places, and its supports are ill-conditioned at places; on a moving cell that is fatal
+//    (below), so the default keeps the rings whole (support_points = 0).
 // 3. Fit: w = sum_{1 <= a+b <= degree} c_ab (u/s)^a (v/s)^b, s the RMS of |(u, v)| over the support;
 //    unweighted least squares (option gaussian_weights: weights exp(-|(u,v)|^2 / (2 s^2))); no
 //    constant term, the surface passes through x_i.
 // 4. Height derivatives at the node: d^a_u d^b_v h = a! b! c_ab / s^(a+b), orders 1 to 4.
-// 5. n, H, K, Lap_S H of the graph (graph_curvature.hpp); n is turned into world coordinates.
-//    Option laplacian=field: Lap_S H is instead the jet's Laplace-Beltrami operator at the node
-//    applied to the field H of every node's jet (monge_jet_laplacian below), as E takes Lap H from
-//    a second fit to its H, but with the degree-6 jet of the same chart and support. The discrete
-//    biharmonic is then one operator applied twice (as C's cotangent Laplacian is), where the
-//    jet's own fourth derivatives are a stencil of alternating signs: on the unit sphere (1280
-//    triangles) the default's force has modes that grow (eigenvalues of dF/dx with real parts up
-//    to +200, against -2000 for the most negative) and field's none; on the RBC its maximum error
-//    of f is 3 to 9 times smaller at 81920 triangles (MT1 2.2e-5 against 2.0e-4, irregular 7.4e-4
-//    against 1.3e-3; tests/bending/test_monge_jet.cpp). On the RBC at 320 and 1280 triangles it
-//    still has growing modes where the 40-point trim leaves an ill-conditioned support, and the
-//    untrimmed rings (support_points=0) remove them (docs/results/bending_stability.md). Not yet
-//    the default: a stretched red cell does not reach equilibrium with it either (bendlab stretch).
+// 5. n, H, K of the graph (graph_curvature.hpp); n is turned into world coordinates. Lap_S H
+//    (laplacian = field, the default) is the jet's Laplace-Beltrami operator at the node applied to
+//    the field H of every node's jet (monge_jet_laplacian below), as E takes Lap H from a second fit
+//    to its H, but with the degree-6 jet of the same chart and support: the discrete biharmonic is
+//    one operator applied twice, as C's cotangent Laplacian is. Option laplacian = jet takes Lap_S H
+//    from the jet's own third and fourth derivatives instead (graph_curvature.hpp), a stencil of
+//    alternating signs.
+//
+// Why these defaults (field, untrimmed): with laplacian = jet and the 40-point trim (the defaults
+// until M had to follow a moving cell) the force has modes that grow: the linearisation dF/dx has
+// eigenvalues with real parts up to +200 on the unit sphere (1280 triangles), an equilibrium, and
+// +524 on the RBC, and bendlab stretch did not hold a red cell still (docs/results/
+// bending_stability.md). With the field operator on whole rings there are none beyond the small ones
+// every method has on the RBC (C's included), and the static errors are smaller too: the maximum
+// error of f on the RBC at 81920 triangles is 2.9e-5 (MT1), 1.2e-4 (MT2), 7.4e-4 (irregular) against
+// 2.0e-4, 4.6e-4, 1.3e-3 (tests/bending/test_monge_jet.cpp). Its Jacobian is still far from
+// symmetric (M is no energy's gradient), which an inertial relaxation cannot settle (see
+// StretchRelaxation in flow/optical_stretch.hpp).
 //
 // Why degree 6 and not the spec's 5: a degree-5 jet's 4th derivatives carry an O(h^2) truncation
 // error fed by the surface's 6th-order Taylor terms, which the symmetric supports of the regular
@@ -78,10 +81,12 @@ struct MongeJetSettings {
   MongeFrame frame = MongeFrame::Covariance;
   bool gaussian_weights = false;
   /// Step 2's trim: of the rings' points, the nearest this many and every point as near as the
-  /// last of them are kept (0: all). 40 is a little more than a regular vertex's 3-ring (36), so
-  /// on regular meshes only the few widened supports are trimmed; see the header comment.
-  int support_points = 40;
-  MongeLaplacian laplacian = MongeLaplacian::Jet;
+  /// last of them are kept (0, the default: all). 40, a little more than a regular vertex's
+  /// 3-ring (36), trims only the few widened supports of regular meshes and helps graded ones
+  /// (see the header comment), but the nearest-40 rule makes the force jump as points trade places
+  /// and leaves ill-conditioned supports whose modes grow in a moving cell.
+  int support_points = 0;
+  MongeLaplacian laplacian = MongeLaplacian::Field;
 };
 
 /// Unknowns of a jet of this degree without constant term: (degree + 1)(degree + 2)/2 - 1.
@@ -171,12 +176,25 @@ class MongeJetWorkspace {
   std::vector<std::unique_ptr<Thread>> threads_;
 };
 
-/// The same fits into `fits` (resized), with the buffers of `ws`.
+/// Lap_S of a field at every node as a stencil: (Lap_S w)_i = sum_k weights[i][k] (w[ids[i][k]] - w[i])
+/// (monge_jet_laplacian's operator, its weights computed with the fits).
+struct MongeJetLaplacianStencil {
+  std::vector<std::vector<int>> ids;
+  std::vector<std::vector<double>> weights;
+  /// out (resized) = Lap_S w; allocates nothing when out has the size already.
+  void apply(const Scalars& w, Scalars& out) const;
+};
+
+/// The same fits into `fits` (resized), with the buffers of `ws`; with `stencil`, also the
+/// Laplace-Beltrami stencil of every node's jet (what monge_jet_laplacian applies), from the fits'
+/// own factorisations (solve_jet_lanes): Method M's laplacian = field for the cost of two more
+/// triangular solves per node, not a second fit.
 void monge_jet_fit(const Topology& topology, const Points& x, const Points& mwa_normal,
                    const MongeJetSettings& settings, const MongeJetSupports& supports, MongeJetWorkspace& ws,
-                   std::vector<MongeJetFit>& fits);
+                   std::vector<MongeJetFit>& fits, MongeJetLaplacianStencil* stencil = nullptr);
 
-/// Lap_S w at every node for a field w given at the nodes: at node i, the Laplace-Beltrami operator
+/// Lap_S w at every node for a field w given at the nodes (the reference of MongeJetLaplacianStencil,
+/// computed again from the positions and the fits, one node at a time): at node i, the Laplace-Beltrami operator
 /// of the graph of i's fitted jet (its metric from the jet's first and second derivatives) applied
 /// to the jet of the same degree fitted by least squares, on the same chart and support, to
 /// w_j - w_i: a linear combination sum_j l_ij (w_j - w_i) over the support (the weights l_ij do not

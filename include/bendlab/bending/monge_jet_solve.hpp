@@ -31,6 +31,12 @@ struct JetLaneSamples {
 /// Coefficients c_k of every lane at coefficients[k * kJetLanes + l] (k < unknowns of `degree`, in
 /// the basis order of monge_jet.cpp: by total degree, then by the power of eta); determined[l] is
 /// the pivot test's verdict. degree 4, 5 or 6.
-void solve_jet_lanes(int degree, const JetLaneSamples& samples, double* coefficients, bool* determined);
+/// With inv_scale (1/s of each lane's chart) and laplacian_y (room for as many values as the
+/// coefficients), also y = M^-1 l with the same factor, l the Laplace-Beltrami operator of the
+/// lane's fitted graph at its node applied to a jet's coefficients (monge_jet_laplacian): the
+/// operator's weight on sample j of a field is then w_j phi_j . y (Method M's laplacian = field,
+/// at the cost of one more pair of triangular solves).
+void solve_jet_lanes(int degree, const JetLaneSamples& samples, double* coefficients, bool* determined,
+                     const double* inv_scale = nullptr, double* laplacian_y = nullptr);
 
 }  // namespace bendlab

@@ -39,12 +39,29 @@ struct FireParameters {
   double max_step_edges = 0.1;     ///< no vertex moves more than this fraction of the mean edge per step
 };
 
+/// How the equilibrium is sought. FIRE moves the vertices as masses (inertial), which converges for
+/// a force that is an energy's gradient or nearly so (A, B, J, S, C, E): its Jacobian is about
+/// symmetric, its eigenvalues -omega^2 real. A force whose Jacobian is far from symmetric (D, ED, M:
+/// docs/results/bending_stability.md) has complex eigenvalues mu = -a + ib, and the undamped motion
+/// x'' = mu x then grows like exp(Re sqrt(mu) t), Re sqrt(mu) > 0 for any b != 0 (flutter): the
+/// masses circle the equilibrium instead of settling. Overdamped relaxation, dx/dt = R (the motion
+/// of a cell in Stokes flow, with unit mobility), decays wherever every eigenvalue has a negative
+/// real part, the condition a flow run needs; it is slower (its steps scale with the ratio of the
+/// stiffest mode to the softest), so Anderson mixing of its last steps accelerates it.
+/// Auto (the default) picks Overdamped for D, ED and M and FIRE for the rest (and for no bending).
+enum class StretchRelaxation { Auto, Fire, Overdamped };
+
+/// The relaxation Auto stands for with this bending method ("none" for no bending).
+StretchRelaxation default_relaxation(const std::string& method);
+std::string to_string(StretchRelaxation r);
+
 struct StretchSpec {
   CellKindSpec cell;                ///< shape, mesh, law, moduli and method (the flow's red blood cell)
   std::vector<double> forces_pN;    ///< total force F at each end, pN, in the order run
   double fraction = 0.02;           ///< fraction of the vertices pulled at each end
   double tolerance_pN = 1e-4;       ///< max nodal residual |F_membrane + F_applied| at equilibrium, pN
-  long max_iterations = 20000;      ///< FIRE steps per force before failing
+  long max_iterations = 20000;      ///< relaxation steps per force before failing
+  StretchRelaxation relaxation = StretchRelaxation::Auto;
   FireParameters fire;
   nlohmann::json to_json() const;
 };
