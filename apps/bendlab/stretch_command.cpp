@@ -262,7 +262,7 @@ const CommandRegistration stretch_registration([](CLI::App& app) {
   cmd->add_option("--relaxation", s.relaxation,
                   "how equilibrium is sought: fire (FIRE, inertial: for forces that are an energy's gradient or "
                   "nearly), overdamped (dx/dt = residual, as a cell in Stokes flow, with Anderson mixing: for forces "
-                  "whose Jacobians are far from symmetric), or auto: overdamped for D, ED and M, fire otherwise")
+                  "whose Jacobians are far from symmetric), or auto: overdamped for M, fire otherwise")
       ->transform(CLI::CheckedTransformer(
           std::map<std::string, StretchRelaxation>{{"auto", StretchRelaxation::Auto},
                                                    {"fire", StretchRelaxation::Fire},

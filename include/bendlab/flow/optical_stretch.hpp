@@ -41,14 +41,14 @@ struct FireParameters {
 
 /// How the equilibrium is sought. FIRE moves the vertices as masses (inertial), which converges for
 /// a force that is an energy's gradient or nearly so (A, B, J, S, C, E): its Jacobian is about
-/// symmetric, its eigenvalues -omega^2 real. A force whose Jacobian is far from symmetric (D, ED, M:
-/// docs/results/bending_stability.md) has complex eigenvalues mu = -a + ib, and the undamped motion
+/// symmetric, its eigenvalues -omega^2 real. A force whose Jacobian is far from symmetric (M, and less
+/// so D and ED: docs/results/bending_stability.md) has complex eigenvalues mu = -a + ib, and the undamped motion
 /// x'' = mu x then grows like exp(Re sqrt(mu) t), Re sqrt(mu) > 0 for any b != 0 (flutter): the
 /// masses circle the equilibrium instead of settling. Overdamped relaxation, dx/dt = R (the motion
 /// of a cell in Stokes flow, with unit mobility), decays wherever every eigenvalue has a negative
 /// real part, the condition a flow run needs; it is slower (its steps scale with the ratio of the
 /// stiffest mode to the softest), so Anderson mixing of its last steps accelerates it.
-/// Auto (the default) picks Overdamped for D, ED and M and FIRE for the rest (and for no bending).
+/// Auto (the default) picks Overdamped for M and FIRE for the rest (and for no bending).
 enum class StretchRelaxation { Auto, Fire, Overdamped };
 
 /// The relaxation Auto stands for with this bending method ("none" for no bending).
