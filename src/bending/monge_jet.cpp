@@ -313,6 +313,8 @@ void laplacian_weights(const MongeJetFit& fit, const Vec3& x0, std::span<const V
 void laplacian_weights(const MongeJetFit& fit, const Vec3& x0, std::span<const Vec3> support, int degree,
                        bool gaussian_weights, std::vector<double>& weights) {
   switch (degree) {
+    case 2: return laplacian_weights<2>(fit, x0, support, gaussian_weights, weights);
+    case 3: return laplacian_weights<3>(fit, x0, support, gaussian_weights, weights);
     case 4: return laplacian_weights<4>(fit, x0, support, gaussian_weights, weights);
     case 5: return laplacian_weights<5>(fit, x0, support, gaussian_weights, weights);
     default: return laplacian_weights<6>(fit, x0, support, gaussian_weights, weights);
@@ -337,16 +339,12 @@ void monge_jet_laplacian(const Topology& t, const Points& x, const MongeJetSetti
     for (int i = 0; i < n; ++i) {
       const MongeJetFit& fit = fits[i];
       const Vec3 x0 = x.row(i).transpose();
-      // The support of the fit: the rings' list trimmed as in monge_jet_fit, or the widened rings.
-      if (fit.rings > lists.rings_used[i]) {
-        ids = k_ring(t, i, fit.rings);
-      } else {
-        ids.assign(lists.vertices.begin() + lists.offsets[i], lists.vertices.begin() + lists.offsets[i + 1]);
-        trim_nearest(settings.support_points, ids, [&](int v) { return (Vec3(x.row(v).transpose()) - x0).squaredNorm(); });
-      }
+      // The support of the fit: the rings' list trimmed as in monge_jet_fit.
+      ids.assign(lists.vertices.begin() + lists.offsets[i], lists.vertices.begin() + lists.offsets[i + 1]);
+      trim_nearest(settings.support_points, ids, [&](int v) { return (Vec3(x.row(v).transpose()) - x0).squaredNorm(); });
       support.resize(ids.size());
       for (std::size_t k = 0; k < ids.size(); ++k) support[k] = x.row(ids[k]).transpose();
-      laplacian_weights(fit, x0, support, settings.degree, settings.gaussian_weights, weights);
+      laplacian_weights(fit, x0, support, fit.degree, settings.gaussian_weights, weights);
       double sum = 0;
       for (std::size_t k = 0; k < ids.size(); ++k) sum += weights[k] * (field[ids[k]] - field[i]);
       out[i] = sum;
@@ -377,11 +375,25 @@ Vec3 covariance_normal(const Vec3& x0, std::span<const Vec3> points, const Vec3&
 MongeJetFit monge_jet_fit_point(const Vec3& x0, const Vec3& n0, std::span<const Vec3> support, int degree,
                                 bool gaussian_weights, Accumulation accumulation) {
   switch (degree) {
+    case 2: return fit_jet<2>(x0, n0, support, gaussian_weights, accumulation);
+    case 3: return fit_jet<3>(x0, n0, support, gaussian_weights, accumulation);
     case 4: return fit_jet<4>(x0, n0, support, gaussian_weights, accumulation);
     case 5: return fit_jet<5>(x0, n0, support, gaussian_weights, accumulation);
     case 6: return fit_jet<6>(x0, n0, support, gaussian_weights, accumulation);
-    default: throw Error(fmt::format("method M: degree must be 4, 5 or 6, got {}", degree));
+    default: throw Error(fmt::format("method M: a jet's degree must be 2 to 6, got {}", degree));
   }
+}
+
+MongeJetFit monge_jet_fallback_fit(const Vec3& x0, const Vec3& n0, std::span<const Vec3> support,
+                                   const MongeJetSettings& settings) {
+  MongeJetFit fit;
+  for (int degree : {4, 2}) {
+    if (degree >= settings.degree) continue;
+    fit = monge_jet_fit_point(x0, n0, support, degree, settings.gaussian_weights);
+    fit.degree = degree;
+    if (fit.valid) break;
+  }
+  return fit;
 }
 
 std::vector<MongeJetFit> monge_jet_fit_nodes(std::span<const MongeJetNode> nodes, int degree,
@@ -533,22 +545,15 @@ void monge_jet_fit(const Topology& t, const Points& x, const Points& mwa_normal,
       for (int l = 0; l < count; ++l) {
         const int i = first + l;
         MongeJetFit& fit = fits[i];
-        int rings = lists.rings_used[i];
-        if (!fit.valid) {
-          // A singular configuration: widen the support ring by ring, one node at a time.
-          nb.start(i);
-          nb.grow_to(rings);
-          while (!fit.valid && nb.add_ring())
-            fit = monge_jet_fit_point(nodes[l].x0, nodes[l].n0, gather(x, nb.vertices(), buffer), settings.degree,
-                                      settings.gaussian_weights);
-          rings = nb.rings();
-          if (stencil && fit.valid) {
-            ids[l] = nb.vertices();
-            laplacian_weights(fit, nodes[l].x0, buffer, settings.degree, settings.gaussian_weights,
+        fit.degree = settings.degree;
+        // (A mesh too small for the jet's unknowns is refused below instead.)
+        if (!fit.valid && static_cast<int>(nodes[l].support.size()) >= monge_jet_unknowns(settings.degree)) {
+          fit = monge_jet_fallback_fit(nodes[l].x0, nodes[l].n0, nodes[l].support, settings);
+          if (fit.valid && stencil)
+            laplacian_weights(fit, nodes[l].x0, nodes[l].support, fit.degree, settings.gaussian_weights,
                               stencil->weights[i]);
-          }
         }
-        fit.rings = rings;
+        fit.rings = lists.rings_used[i];
         if (stencil) stencil->ids[i] = ids[l];
       }
     }
@@ -561,9 +566,10 @@ void monge_jet_fit(const Topology& t, const Points& x, const Points& mwa_normal,
       throw Error(fmt::format("method M: vertex {} reaches only {} other vertices, fewer than the {} unknowns of a "
                               "degree-{} jet: the mesh is too coarse (refine it or lower the option degree)",
                               i, f.points, unknowns, settings.degree));
-    throw Error(fmt::format("method M: the degree-{} jet at vertex {} is not determined by its {} support points "
-                            "(singular least-squares system, even with every vertex the mesh connects to it)",
-                            settings.degree, i, f.points));
+    throw Error(fmt::format("method M: the jet at vertex {} is not determined by its {} support points, neither of "
+                            "degree {} nor of a lower degree down to 2 (singular least-squares system: the "
+                            "neighbourhood folds over in the tangent plane)",
+                            i, f.points, settings.degree));
   }
 }
 
@@ -610,7 +616,8 @@ MethodInfo MongeJetMethod::info() {
                {int_option("degree", 4, 6, 6, "degree of the fitted height polynomial (4, 5 or 6)"),
                 int_option("support_rings", 2, 3, 3,
                            "fitting support in rings of neighbours (widened while it has fewer than "
-                           "unknowns + 4 points or the fit is singular)"),
+                           "unknowns + 4 points; where it does not determine the jet, the degree is lowered to 4, "
+                           "then 2)"),
                 int_option("support_points", 0, 1000, 0,
                            "keep the nearest this many points of the rings, and any as near as the last "
                            "(0: all; else at least unknowns + 4)"),
@@ -641,12 +648,15 @@ void MongeJetMethod::fields(const Topology& topology, const Points& x, BendingRe
   out.H.resize(n);
   out.K.resize(n);
   out.lapH.resize(n);
+  long fallbacks = 0;
   for (Eigen::Index i = 0; i < n; ++i) {
+    fallbacks += fits[i].degree != settings_.degree;
     out.normal.row(i) = fits[i].normal.transpose();
     out.H[i] = fits[i].H;
     out.K[i] = fits[i].K;
     out.lapH[i] = fits[i].lapH;
   }
+  if (fallbacks > 0) fallbacks_.fetch_add(fallbacks, std::memory_order_relaxed);
   if (field) ws->stencil.apply(out.H, out.lapH);
   out.area.swap(geometry.mixed_area);  // no copy; next call the arrays are reused
 }

@@ -32,6 +32,17 @@ const MembraneModel& SuspensionSolver::membrane() const {
   return cell_membrane(0);
 }
 
+nlohmann::json SuspensionSolver::summary() const {
+  std::vector<const BendingMethod*> methods;
+  for (int c = 0; c < num_cells(); ++c) {
+    const BendingMethod* m = cell_membrane(c).bending();
+    if (m && std::find(methods.begin(), methods.end(), m) == methods.end()) methods.push_back(m);
+  }
+  long fallbacks = 0;
+  for (const BendingMethod* m : methods) fallbacks += m->fallback_count();
+  return {{"bending_fallbacks", fallbacks}};
+}
+
 std::vector<SolverBody> SuspensionSolver::bodies() const {
   std::vector<SolverBody> b;
   b.reserve(static_cast<std::size_t>(num_cells()));

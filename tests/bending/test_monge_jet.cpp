@@ -586,3 +586,35 @@ TEST(MongeJet, RbcMaximumErrorOfFConvergesAtSecondOrder) {
   }
 #endif
 }
+
+TEST(MongeJet, ASupportOnThreeLinesFallsBackToDegreeTwo) {
+  // 36 points on three lines through the node in the tangent plane, on the paraboloid
+  // h = 0.1 u^2 + 0.3 v^2: the cubic that is the product of the three lines vanishes on all of them,
+  // so the jets of degree 6 and 4 (which contain it times any polynomial of degree 3 or 1) are not
+  // determined; degree 2 is, and is exact on the paraboloid: H = (h_uu + h_vv) / 2 = 0.4 up to sign.
+  const Vec3 x0(0.2, -0.1, 0.4), n0 = Vec3(0.3, 0.2, 1.0).normalized();
+  const Vec3 t1 = n0.unitOrthogonal(), t2 = n0.cross(t1);
+  std::vector<Vec3> support;
+  for (int line = 0; line < 3; ++line)
+    for (int k = 1; k <= 12; ++k) {
+      const double angle = 0.4 + line * 1.1, r = (k % 2 ? 1.0 : -1.0) * 0.05 * ((k + 1) / 2);
+      const double u = r * std::cos(angle), v = r * std::sin(angle);
+      support.push_back(x0 + u * t1 + v * t2 + (0.1 * u * u + 0.3 * v * v) * n0);
+    }
+  MongeJetSettings settings;
+  EXPECT_FALSE(monge_jet_fit_point(x0, n0, support, 6).valid);
+  EXPECT_FALSE(monge_jet_fit_point(x0, n0, support, 4).valid);
+  const MongeJetFit fit = monge_jet_fallback_fit(x0, n0, support, settings);
+  ASSERT_TRUE(fit.valid);
+  EXPECT_EQ(fit.degree, 2);
+  EXPECT_NEAR(std::abs(fit.H), 0.4, 1e-9);
+  EXPECT_NEAR(fit.K, 4 * 0.1 * 0.3, 1e-9);
+  EXPECT_NEAR(std::abs(fit.normal.dot(n0)), 1.0, 1e-12);
+  // On a support that determines the degree-6 jet nothing falls back.
+  std::vector<Vec3> spread;
+  for (int k = 0; k < 40; ++k) {
+    const double u = 0.3 * std::cos(2.4 * k) * std::sqrt((k + 1) / 40.0), v = 0.3 * std::sin(2.4 * k) * std::sqrt((k + 1) / 40.0);
+    spread.push_back(x0 + u * t1 + v * t2 + (0.1 * u * u + 0.3 * v * v) * n0);
+  }
+  EXPECT_TRUE(monge_jet_fit_point(x0, n0, spread, 6).valid);
+}

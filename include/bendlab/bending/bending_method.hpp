@@ -40,6 +40,10 @@ class BendingMethod {
   virtual ~BendingMethod() = default;
   /// Short name: "A", "B", "C", "D", "E", "ED", "S", "J".
   virtual std::string name() const = 0;
+  /// Vertex evaluations, since the method was made, where it fell back to a simpler rule than its
+  /// own (Method M: a jet of lower degree where the support did not determine the jet); 0 for the
+  /// methods without a fallback. Runs report it (summary.json's bending_fallbacks).
+  virtual long fallback_count() const { return 0; }
   /// Every per-vertex quantity of the method.
   virtual BendingResult compute(const Topology& topology, const Points& x, double kappa_b) const = 0;
   /// The same into `out`, whose arrays are reused: the built-in methods allocate nothing once warm

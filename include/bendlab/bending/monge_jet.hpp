@@ -10,9 +10,13 @@
 //    the 2-ring of i, signed to agree with the angle-weighted (MWA) normal; option frame =
 //    angle-weighted takes the MWA normal itself. t1, t2 complete a right-handed frame.
 // 2. Support: the vertices within `rings` edge-rings (i excluded; option support_rings), widened ring
-//    by ring while it has fewer than monge_jet_min_points(degree) points (31 for degree 6) or while
-//    the fit is singular. The support depends on the connectivity only, so the force is a smooth
-//    function of the positions. Option support_points = k trims it to the k nearest to x_i (with
+//    by ring while it has fewer than monge_jet_min_points(degree) points (31 for degree 6). The
+//    support depends on the connectivity only, so the force is a smooth function of the positions.
+//    Where it does not determine the jet (a singular fit: on a deformed cell, a patch that folds
+//    over in the chart), the jet's degree is lowered on the same support, to 4 and then to 2
+//    (MongeJetFit::degree), never the support widened: a wider support reaches farther round a
+//    deformed cell and is worse (in a 10 um tube the widening once grew a support to all 641 other
+//    vertices of the cell and still failed). Option support_points = k trims it to the k nearest to x_i (with
 //    every point as near as the last one kept): where the mesh is graded (Rivara refinement) or a
 //    vertex has valence 8-10, the 3-ring holds 50 and more points and reaches farther on the coarse
 //    side, and k = 40 took r_max of f on the Rivara meshes of table 3 from 2.6 (MT2) and 2.4 (MT1) to
@@ -52,6 +56,7 @@
 // largely cancel: on the RBC its maximal error of f at 81920 triangles is 2e-4 (MT1), 1.3e-3
 // (irregular), 2e-4 (octahedron, 131072) against degree 5's 8e-3 to 1e-2, it is also the more
 // accurate from 5120 triangles on, and the capsule runs are stable (docs/results/shear.md).
+#include <atomic>
 #include <memory>
 #include <mutex>
 #include <span>
@@ -103,6 +108,8 @@ struct MongeJetFit {
   Vec3 normal = Vec3::Zero();  ///< unit, world coordinates, on the side of n0
   double H = 0, K = 0, lapH = 0;
   int rings = 0;             ///< rings of the support used (set by monge_jet_fit)
+  int degree = 0;            ///< the jet's degree (set by monge_jet_fit: the setting's, or 4 or 2 where that
+                             ///< one was not determined by the support)
   int points = 0;            ///< support points used
 };
 
@@ -114,11 +121,19 @@ Vec3 covariance_normal(const Vec3& x0, std::span<const Vec3> points, const Vec3&
 /// path, used by the method) or as the sum of outer products phi phi^T (the plain reference).
 enum class Accumulation { Moments, OuterProducts };
 
-/// Steps 3-5 at one node: the jet of `degree` fitted to `support` (positions, the node excluded) in
-/// the chart of unit normal n0. Invalid (valid = false) when there are fewer points than unknowns,
+/// Steps 3-5 at one node: the jet of `degree` (2 to 6; below 4 the fallback of step 2) fitted to
+/// `support` (positions, the node excluded) in the chart of unit normal n0. Invalid (valid = false) when there are fewer points than unknowns,
 /// or the normal matrix is numerically singular.
 MongeJetFit monge_jet_fit_point(const Vec3& x0, const Vec3& n0, std::span<const Vec3> support, int degree,
                                 bool gaussian_weights = false, Accumulation accumulation = Accumulation::Moments);
+
+/// Step 2's fallback where the support does not determine the jet of settings.degree: the jet of
+/// degree 4 (if below settings.degree) and then of degree 2 on the same support, the first that is
+/// determined (MongeJetFit::degree says which; invalid if neither is). A support that does not
+/// determine a degree-6 jet has points on a curve of low degree in the chart (on a deformed cell:
+/// a patch folded over in the tangent plane); a lower degree needs fewer independent directions.
+MongeJetFit monge_jet_fallback_fit(const Vec3& x0, const Vec3& n0, std::span<const Vec3> support,
+                                   const MongeJetSettings& settings);
 
 /// One node's problem for monge_jet_fit_nodes: the node, its chart normal and its support.
 struct MongeJetNode {
@@ -133,8 +148,7 @@ struct MongeJetNode {
 std::vector<MongeJetFit> monge_jet_fit_nodes(std::span<const MongeJetNode> nodes, int degree,
                                              bool gaussian_weights = false);
 
-/// Step 2's supports before any widening for a singular fit, which depend on the connectivity
-/// only (built once per mesh and kept by the method): for every vertex the vertices within `rings`
+/// Step 2's supports, which depend on the connectivity only (built once per mesh and kept by the method): for every vertex the vertices within `rings`
 /// rings, widened while fewer than monge_jet_min_points, listed ring after ring (VertexRings order).
 struct MongeJetSupports {
   std::vector<int> offsets;     ///< N + 1: vertex i's support is vertices[offsets[i] .. offsets[i + 1])
@@ -148,9 +162,9 @@ struct MongeJetSupports {
   bool matches(const Topology& topology, const MongeJetSettings& settings) const;
 };
 
-/// The fit at every node, with the support rule of step 2 (rings widened where needed). Throws
-/// bendlab::Error naming the method and the first vertex that cannot be fitted (too few vertices in
-/// the whole connected mesh, or a singular system even with every vertex), before anything else.
+/// The fit at every node, with the support rule of step 2 (and its fallback to a lower degree).
+/// Throws bendlab::Error naming the method and the first vertex that cannot be fitted (too few
+/// vertices in the whole connected mesh, or a singular system even at degree 2).
 std::vector<MongeJetFit> monge_jet_fit(const Topology& topology, const Points& x, const Points& mwa_normal,
                                        const MongeJetSettings& settings);
 /// The same with the supports built beforehand (refused, bendlab::Error, when they do not match).
@@ -213,6 +227,8 @@ class MongeJetMethod : public VariationalMethod {
   static MethodInfo info();
 
   std::string name() const override { return "M"; }
+  /// Vertex evaluations whose jet fell back to degree 4 or 2 (step 2), over every call so far.
+  long fallback_count() const override { return fallbacks_.load(std::memory_order_relaxed); }
 
  protected:
   /// n, H, K, lapH from the jets and the mixed area; eq. (10) and c0 / ADE are VariationalMethod's.
@@ -226,6 +242,7 @@ class MongeJetMethod : public VariationalMethod {
   std::shared_ptr<const MongeJetSupports> supports_for(const Topology& topology) const;
   static constexpr std::size_t kMaxCachedTopologies = 4;
   MongeJetSettings settings_;
+  mutable std::atomic<long> fallbacks_{0};
   mutable std::mutex cache_mutex_;
   mutable std::unordered_map<const Topology*, std::shared_ptr<const MongeJetSupports>> cache_;
   struct Workspace;

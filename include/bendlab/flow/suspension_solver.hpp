@@ -49,6 +49,10 @@ class SuspensionSolver : public CapsuleSolver {
   std::string name() const final { return "lbm-suspension"; }
   /// The first cell's membrane (throws without cells).
   const MembraneModel& membrane() const final;
+  /// bending_fallbacks: the vertex evaluations of the cells' bending methods that fell back to a
+  /// simpler rule (BendingMethod::fallback_count, over the methods the cells share, in this process
+  /// since they were made: a resumed run counts from its resume).
+  nlohmann::json summary() const override;
   std::vector<SolverBody> bodies() const final;
   /// Every vertex, cell after cell, in um, as of the last report (or the last add_cell/restore).
   const Points& positions() const final { return x_; }
