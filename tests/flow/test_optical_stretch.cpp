@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cmath>
 #include <set>
+#include <string>
+#include <vector>
 
 #include "bendlab/flow/optical_stretch.hpp"
 #include "bendlab/geometry/measures.hpp"
@@ -159,4 +161,39 @@ TEST(OpticalStretch, NeoHookeanCellStretchesToo) {
   const StretchPoint p1 = run.equilibrate(40);
   ASSERT_TRUE(p0.converged && p1.converged) << p0.failure << p1.failure;
   EXPECT_GT(p1.measures.axial_um, p0.measures.axial_um);
+}
+
+TEST(OpticalStretch, EveryMethodHoldsTheUnloadedCellStillAndMostStretchIt) {
+  // mt1:1280, the study's mesh: every method relaxes the reference cell at F = 0 (Method M did not
+  // before its Laplacian and relaxation changed: docs/results/rbc_stretch.md), with the relaxation
+  // --relaxation auto picks, and all but two stretch it to 100 pN in one go. Open (issue: every
+  // bending method where cells move): ED does not settle under load with either relaxation, and M
+  // diverges beyond about 20 pN; M is held to the unloaded cell and a small load here.
+#if defined(__SANITIZE_ADDRESS__)
+  const std::vector<std::string> methods = {"A", "C", "M"};  // the sanitizers make the rest too slow
+#else
+  const std::vector<std::string> methods = {"A", "B", "C", "D", "E", "ED", "S", "J", "M"};
+#endif
+  for (const std::string& method : methods) {
+    StretchSpec s;
+    s.cell.mesh = "mt1:1280";
+    s.cell.method = method;
+    s.forces_pN = {0};
+    OpticalStretch run(s);
+    EXPECT_EQ(run.spec().relaxation, default_relaxation(method)) << method;
+    const StretchPoint p0 = run.equilibrate(0);
+    ASSERT_TRUE(p0.converged) << method << ": " << p0.failure;
+    // The unloaded cell stays within 5 % of its reference diameters (7.82 um): it yields only to its
+    // own bending force, which is no equilibrium of the biconcave shape (A's dihedral-angle energy,
+    // whose modulus is not the Helfrich one on this mesh, moves it most, by about 4 %), and no
+    // growing mode runs away with it.
+    EXPECT_NEAR(p0.measures.axial_um, 7.82, 0.05 * 7.82) << method;
+    EXPECT_NEAR(p0.measures.transverse_um, 7.82, 0.05 * 7.82) << method;
+    if (method == "ED") continue;
+    const double load = method == "M" ? 15.987 : 100.0;  // Mills et al.'s first force for M
+    const StretchPoint p1 = run.equilibrate(load);
+    ASSERT_TRUE(p1.converged) << method << " at " << load << " pN: " << p1.failure;
+    EXPECT_GT(p1.measures.axial_um, p0.measures.axial_um + 1.0) << method;
+    EXPECT_LT(p1.measures.transverse_um, p0.measures.transverse_um) << method;
+  }
 }
