@@ -31,9 +31,10 @@ PAPER_METHODS = ["A", "B", "C", "D", "E", "S"]
 NOT_IN_PAPER = {"ED": "the paper's proposed mixture (E for n, H, K and D's operator for Lap H), not in its tables",
                 "J": "Juelicher's edge-based mean curvature and its energy gradient (Juelicher 1996, compared by "
                      "Bian et al. 2020); the paper has no Method J",
-                "M": "Monge jets (../shared/spec/METHOD_M.md): a degree-5 height polynomial fitted on the 3-ring in the "
-                     "chart of the 2-ring's covariance normal gives n, H, K and Lap H from one fit; beyond the paper, "
-                     "its answer to the paper's open problem (no method's maximal error of f converges)"}
+                "M": "Monge jets (../shared/spec/METHOD_M.md): a degree-6 height polynomial fitted on the 3-ring in the "
+                     "chart of the 2-ring's covariance normal gives n, H and K, and the fits' Laplace-Beltrami operator "
+                     "applied to H gives Lap H; beyond the paper, its answer to the paper's open problem (no method's "
+                     "maximal error of f converges)"}
 # None: the method does not compute the quantity (empty cell in the paper).
 PAPER_TABLE2 = {
     "max": {

@@ -166,11 +166,11 @@ TEST(OpticalStretch, NeoHookeanCellStretchesToo) {
 TEST(OpticalStretch, EveryMethodHoldsTheUnloadedCellStillAndMostStretchIt) {
   // mt1:1280, the study's mesh: every method relaxes the reference cell at F = 0 (Method M did not
   // before its Laplacian and relaxation changed: docs/results/rbc_stretch.md), with the relaxation
-  // --relaxation auto picks, and all but two stretch it to 100 pN in one go. Open (issue: every
+  // --relaxation auto picks, and all but three stretch it to 100 pN in one go. Open (issue: every
   // bending method where cells move): ED does not settle under load with either relaxation, and M
   // diverges beyond about 20 pN; M is held to the unloaded cell and a small load here.
 #if defined(__SANITIZE_ADDRESS__)
-  const std::vector<std::string> methods = {"A", "C", "M"};  // the sanitizers make the rest too slow
+  const std::vector<std::string> methods = {"M"};  // the sanitizers make the rest too slow
 #else
   const std::vector<std::string> methods = {"A", "B", "C", "D", "E", "ED", "S", "J", "M"};
 #endif
@@ -189,7 +189,8 @@ TEST(OpticalStretch, EveryMethodHoldsTheUnloadedCellStillAndMostStretchIt) {
     // growing mode runs away with it.
     EXPECT_NEAR(p0.measures.axial_um, 7.82, 0.05 * 7.82) << method;
     EXPECT_NEAR(p0.measures.transverse_um, 7.82, 0.05 * 7.82) << method;
-    if (method == "ED") continue;
+    // S costs 20 s to stretch on this mesh (the study does it); ED does not settle under load.
+    if (method == "ED" || method == "S") continue;
     const double load = method == "M" ? 15.987 : 100.0;  // Mills et al.'s first force for M
     const StretchPoint p1 = run.equilibrate(load);
     ASSERT_TRUE(p1.converged) << method << " at " << load << " pN: " << p1.failure;
