@@ -170,15 +170,9 @@ def run(D, H, method="C", mesh="mt1:1280", t_end=T_END, contact_cutoff=0.0, leng
 D20_TIME_SCALE = 20.0
 
 
-# Method M's run at time scale 10: its jets cost about ten times C's force, and the run of about 4.5
-# hours on one core becomes one of about 30 minutes (S = 10 is within 2 standard errors of S = 1 on
-# this case: docs/results/time_scaling.md).
-M_TIME_SCALE = 10.0
-
-
 def parts(t_end, methods=METHODS):
     return {
-        "methods": [run(10, 0.3, m, t_end=t_end, time_scale=M_TIME_SCALE if m == "M" else 1.0) for m in methods],
+        "methods": [run(10, 0.3, m, t_end=t_end) for m in methods],
         "diameters": [run(D, 0.3, t_end=t_end, time_scale=D20_TIME_SCALE if D == 20 else 1.0) for D in (10, 15, 20)],
         "hematocrit": [run(10, H, t_end=t_end) for H in (0.2, 0.4)],
         "resolution": [run(10, 0.3, "C", "mt1:5120", t_end=t_end)],
