@@ -144,6 +144,18 @@ def number(field):
     return float(field) if field != "" else float("nan")
 
 
+def number_list(text, option, valid, requirement):
+    """The comma-separated numbers of a command-line option, each of which `valid` accepts; else the
+    script exits with an error naming the option and `requirement` (what every number must be)."""
+    try:
+        values = [float(v) for v in text.split(",")]
+    except ValueError:
+        raise SystemExit(f"error: {option}: not a list of numbers: '{text}'")
+    if not values or any(not (valid(v) and math.isfinite(v)) for v in values):
+        raise SystemExit(f"error: {option}: every {requirement}: '{text}'")
+    return values
+
+
 def finished(folder, run):
     """The summary of the finished run `run` in `folder` (its arguments match), else None."""
     summary = read_summary(folder)

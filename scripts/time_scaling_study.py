@@ -78,12 +78,8 @@ def main(argv):
     ap.add_argument("--list", action="store_true", help="print the runs and their state; run nothing")
     ap.add_argument("--doc-only", action="store_true", help="write the document from the finished runs; run nothing")
     args = ap.parse_args(argv[1:])
-    try:
-        scales = [float(s) for s in args.scales.split(",")]
-    except ValueError:
-        raise SystemExit(f"error: --scales: not a list of numbers: '{args.scales}'")
-    if not scales or any(not (s >= 1 and math.isfinite(s)) for s in scales):
-        raise SystemExit(f"error: --scales: every factor must be a finite number >= 1: '{args.scales}'")
+    scales = study_runner.number_list(args.scales, "--scales", lambda s: s >= 1,
+                                      "factor must be a finite number >= 1")
     runs = [ScaledRun(s) for s in scales]
     work = Path(args.work)
     bendlab = study_runner.bendlab_binary(args.bendlab) if not args.doc_only else None

@@ -280,12 +280,7 @@ def main(argv):
     ap.add_argument("--list", action="store_true", help="print the runs and their state; run nothing")
     ap.add_argument("--doc-only", action="store_true", help="write the document from the finished runs; run nothing")
     args = ap.parse_args(argv[1:])
-    try:
-        rates = [float(r) for r in args.rates.split(",")]
-    except ValueError:
-        raise SystemExit(f"error: --rates: not a list of numbers: '{args.rates}'")
-    if not rates or any(not (r > 0 and math.isfinite(r)) for r in rates):
-        raise SystemExit(f"error: --rates: every rate must be positive: '{args.rates}'")
+    rates = study_runner.number_list(args.rates, "--rates", lambda r: r > 0, "rate must be positive")
 
     if not (args.travel > 0 and math.isfinite(args.travel)):
         raise SystemExit(f"error: --travel must be positive: {args.travel}")

@@ -82,6 +82,7 @@ void finish_fit(MongeJetFit& fit, int degree, const double* c, int stride) {
   fit.H = g.H;
   fit.K = g.K;
   fit.lapH = g.lapH;
+  fit.degree = degree;
   fit.valid = true;
 }
 
@@ -390,7 +391,6 @@ MongeJetFit monge_jet_fallback_fit(const Vec3& x0, const Vec3& n0, std::span<con
   for (int degree : {4, 2}) {
     if (degree >= settings.degree) continue;
     fit = monge_jet_fit_point(x0, n0, support, degree, settings.gaussian_weights);
-    fit.degree = degree;
     if (fit.valid) break;
   }
   return fit;
@@ -545,7 +545,6 @@ void monge_jet_fit(const Topology& t, const Points& x, const Points& mwa_normal,
       for (int l = 0; l < count; ++l) {
         const int i = first + l;
         MongeJetFit& fit = fits[i];
-        fit.degree = settings.degree;
         // (A mesh too small for the jet's unknowns is refused below instead.)
         if (!fit.valid && static_cast<int>(nodes[l].support.size()) >= monge_jet_unknowns(settings.degree)) {
           fit = monge_jet_fallback_fit(nodes[l].x0, nodes[l].n0, nodes[l].support, settings);

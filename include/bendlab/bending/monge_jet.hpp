@@ -108,8 +108,8 @@ struct MongeJetFit {
   Vec3 normal = Vec3::Zero();  ///< unit, world coordinates, on the side of n0
   double H = 0, K = 0, lapH = 0;
   int rings = 0;             ///< rings of the support used (set by monge_jet_fit)
-  int degree = 0;            ///< the jet's degree (set by monge_jet_fit: the setting's, or 4 or 2 where that
-                             ///< one was not determined by the support)
+  int degree = 0;            ///< the fitted jet's degree (0 when invalid): in monge_jet_fit the
+                             ///< setting's, or 4 or 2 where that one was not determined by the support
   int points = 0;            ///< support points used
 };
 

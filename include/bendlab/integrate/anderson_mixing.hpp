@@ -15,7 +15,8 @@ namespace bendlab {
 
 class AndersonMixing {
  public:
-  /// depth >= 1: the differences kept (Walker & Ni use 1-10; more costs memory, rarely steps).
+  /// depth >= 1: the differences kept (Walker & Ni use 1-10; a deep history can make the nonlinear
+  /// iteration less stable, not only dearer).
   explicit AndersonMixing(int depth);
 
   /// The step dx from x (the current iterate) and f (its plain update): f itself when there is no
