@@ -175,8 +175,9 @@ void ContactSearch::for_each_pair(const Vessel& vessel, const Points& x, const s
   }
 }
 
-double ContactSearch::add_cell_contact(const Vessel& vessel, const ContactLaw& law, const Points& x,
-                                       const std::vector<int>& cell_of, Points& F) {
+double ContactSearch::add_cell_contact_reference(const Vessel& vessel, const ContactLaw& law, const Points& x,
+                                                 const std::vector<int>& cell_of, Points& F) {
+  ++list_builds_;
   // Each vertex's force is summed over its partners in the order of their rows, not in the order
   // the bins give them (which depends on every vertex's position: the bins of an axis without a
   // period span the vertices present), so that it does not depend on the vertices beyond the
@@ -204,6 +205,83 @@ double ContactSearch::min_cell_distance(const Vessel& vessel, const Points& x, c
   double m = range;
   for_each_pair<false>(vessel, x, cell_of, range, [&](int, int, const Vec3&, double r) { m = std::min(m, r); }, [](int) {});
   return m;
+}
+
+bool ContactSearch::list_is_current(const Vessel& vessel, const ContactLaw& law, const Points& x,
+                                    const std::vector<int>& cell_of) const {
+  if (list_cutoff_ != law.cutoff || list_period_ != vessel.period() || list_x_.rows() != x.rows() || list_cell_ != cell_of) return false;
+  const double limit = 0.25 * (kSkinFraction * law.cutoff) * (kSkinFraction * law.cutoff);  // (skin / 2)^2
+  for (Eigen::Index i = 0; i < x.rows(); ++i) {
+    const double dx = x(i, 0) - list_x_(i, 0), dy = x(i, 1) - list_x_(i, 1), dz = x(i, 2) - list_x_(i, 2);
+    if (!(dx * dx + dy * dy + dz * dz <= limit)) return false;  // a non-finite position rebuilds too
+  }
+  return true;
+}
+
+void ContactSearch::build_list(const Vessel& vessel, const ContactLaw& law, const Points& x, const std::vector<int>& cell_of) {
+  ++list_builds_;
+  found_.clear();
+  for_each_pair<true>(vessel, x, cell_of, (1.0 + kSkinFraction) * law.cutoff,
+                      [&](int i, int j, const Vec3&, double) { found_.emplace_back(i, j); }, [](int) {});
+  std::sort(found_.begin(), found_.end());
+  const Eigen::Index n = x.rows();
+  list_start_.assign(static_cast<std::size_t>(n) + 1, 0);
+  list_row_.resize(found_.size());
+  for (std::size_t k = 0; k < found_.size(); ++k) {
+    ++list_start_[static_cast<std::size_t>(found_[k].first) + 1];
+    list_row_[k] = found_[k].second;
+  }
+  for (Eigen::Index i = 0; i < n; ++i) list_start_[static_cast<std::size_t>(i) + 1] += list_start_[static_cast<std::size_t>(i)];
+  list_x_ = x;
+  list_cell_ = cell_of;
+  list_cutoff_ = law.cutoff;
+  list_period_ = vessel.period();
+}
+
+double ContactSearch::add_cell_contact(const Vessel& vessel, const ContactLaw& law, const Points& x,
+                                       const std::vector<int>& cell_of, Points& F) {
+  if (static_cast<Eigen::Index>(cell_of.size()) != x.rows()) {
+    throw Error(fmt::format("contact search: {} cell indices for {} vertices", cell_of.size(), x.rows()));
+  }
+  if (!list_is_current(vessel, law, x, cell_of)) build_list(vessel, law, x, cell_of);
+  // The separations as the search in every call takes them (for_each_pair): with three bins of
+  // r_c or more along every periodic axis, from the positions wrapped into the period, the
+  // partner's image shifted by the period multiple that brings it within half a period (the
+  // neighbour bin's shift for every pair closer than r_c); else the nearest image of x_i - x_j.
+  const Vec3 period = vessel.period();
+  bool shifted_images = true;
+  for (int a = 0; a < 3; ++a)
+    if (vessel.periodic(a) && static_cast<int>(std::floor(period[a] / law.cutoff)) < 3) shifted_images = false;
+  const Eigen::Index n = x.rows();
+  wrapped_.resize(n, 3);
+  for (Eigen::Index i = 0; i < n; ++i)
+    for (int a = 0; a < 3; ++a) {
+      double c = x(i, a);
+      if (vessel.periodic(a)) c -= period[a] * std::floor((c + 0.5 * period[a]) / period[a]);  // as bin()
+      wrapped_(i, a) = c;
+    }
+  const double r2max = law.cutoff * law.cutoff;
+  double energy = 0;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    for (int k = list_start_[static_cast<std::size_t>(i)]; k < list_start_[static_cast<std::size_t>(i) + 1]; ++k) {
+      const int j = list_row_[static_cast<std::size_t>(k)];
+      Vec3 d;
+      if (shifted_images) {
+        for (int a = 0; a < 3; ++a) {
+          const double shift = vessel.periodic(a) ? period[a] * std::round((wrapped_(i, a) - wrapped_(j, a)) / period[a]) : 0.0;
+          d[a] = (wrapped_(i, a) - shift) - wrapped_(j, a);
+        }
+      } else {
+        d = vessel.minimum_image(row(x, i) - row(x, j));
+      }
+      const double r2 = d.squaredNorm();
+      if (!(r2 < r2max)) continue;
+      const double r = std::sqrt(r2);
+      if (j > i) energy += law.energy(r);
+      if (r > 0) F.row(i) += (law.force(r) / r * d).transpose();  // r = 0: no direction
+    }
+  }
+  return energy;
 }
 
 }  // namespace bendlab

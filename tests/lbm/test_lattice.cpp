@@ -273,6 +273,42 @@ TEST(Lattice, ClearForceZeroesEveryNodeWritten) {
   EXPECT_TRUE(all_zero());
 }
 
+// The immersed boundary's gather, velocities_of_run, against velocity() node by node, bit for bit:
+// whole rows and runs that start and end inside a row (which wrap along x at odd steps), at both
+// parities, on a periodic box, moving walls and a tube's section (whose solid rows give zero).
+TEST(Lattice, VelocitiesOfARunEqualVelocityAtEveryNode) {
+  std::vector<LatticeConfig> configs;
+  configs.push_back(box(5, 4, 6, 0.9, false));
+  configs.push_back(box(70, 3, 4, 1.0, true, 0.02));  // rows longer than one chunk of the run
+  LatticeConfig tube = box(6, 12, 12, 1.2, false);
+  tube.collision = Collision::TRT;
+  tube.section = std::make_shared<TubeWall>(4.3);
+  configs.push_back(tube);
+  for (const LatticeConfig& c : configs) {
+    Lattice L(c);
+    L.initialise([](const Vec3& x) { return Vec3(0.01 * std::cos(x.z()), 0.003 * std::sin(x.x()), 0.002 * x.y()); });
+    L.set_uniform_force(Vec3(1e-5, -2e-5, 3e-6));
+    L.add_force(1, Vec3(2e-4, 1e-4, -3e-4));
+    const int nx = L.nx();
+    for (int step = 0; step < 3; ++step) {
+      for (std::size_t row = 0; row < L.num_nodes() / static_cast<std::size_t>(nx); ++row) {
+        for (const auto& [from, count] : {std::pair{0, nx}, std::pair{1, nx - 2}, std::pair{nx - 1, 1}}) {
+          const std::size_t first = row * static_cast<std::size_t>(nx) + static_cast<std::size_t>(from);
+          std::vector<double> u(3 * static_cast<std::size_t>(count));
+          L.velocities_of_run(first, count, u.data());
+          for (int t = 0; t < count; ++t) {
+            const Vec3 v = L.velocity(first + static_cast<std::size_t>(t));
+            for (int d = 0; d < 3; ++d) ASSERT_EQ(u[3 * static_cast<std::size_t>(t) + static_cast<std::size_t>(d)], v[d]) << "step " << step << " node " << first + static_cast<std::size_t>(t);
+          }
+        }
+      }
+      L.step();
+    }
+    std::vector<double> u(3 * static_cast<std::size_t>(nx));
+    EXPECT_THROW(L.velocities_of_run(1, nx, u.data()), Error);  // leaves the row
+  }
+}
+
 // The row table of populations() against the coordinates of populations_reference(), every node
 // at both parities, on every kind of lattice: fully periodic, moving walls, a tube's section and a
 // slit's, with a flow and a force so that no population is trivially equal to another.

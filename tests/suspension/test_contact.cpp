@@ -96,6 +96,39 @@ TEST(ContactSearch, CellListEqualsAllPairsWithPeriodicImages) {
   }
 }
 
+// The Verlet list against the search in every call, bit for bit, along a random walk of the
+// vertices: steps below the skin (the list is kept), jumps beyond it and across the period (it is
+// rebuilt), a changed cell and a changed cutoff (rebuilt). The energy is the same sum in another
+// order.
+TEST(ContactSearch, VerletListEqualsTheSearchInEveryCall) {
+  for (const Vessel& v : {Vessel::channel(4.0, 3.0, 5.0), Vessel::tube(4.0, 2.5), Vessel::box(2.0, 1.5, 1.2)}) {
+    std::vector<int> cell_of;
+    Points x = random_cloud(v, 5, 60, cell_of, 21);
+    ContactLaw law{1.3, 0.45};
+    ContactSearch listed, searched;
+    std::mt19937_64 rng(5);
+    std::normal_distribution<double> step(0.0, 0.01);
+    int calls = 0;
+    for (int s = 0; s < 60; ++s) {
+      if (s == 20) x.col(0).array() += v.length();  // every vertex by a whole period: same forces, new list
+      if (s == 30) cell_of[7] = 4;                  // a vertex changes cell
+      if (s == 40) law.cutoff = 0.4;
+      for (Eigen::Index i = 0; i < x.rows(); ++i)
+        for (int a = 0; a < 3; ++a) x(i, a) += step(rng);
+      Points F = Points::Zero(x.rows(), 3), G = Points::Zero(x.rows(), 3);
+      const double e = listed.add_cell_contact(v, law, x, cell_of, F);
+      const double eref = searched.add_cell_contact_reference(v, law, x, cell_of, G);
+      ++calls;
+      ASSERT_EQ(F, G) << v.describe() << " call " << s;
+      ASSERT_GT(eref, 0) << v.describe();
+      EXPECT_NEAR(e, eref, 1e-13 * eref) << v.describe() << " call " << s;
+    }
+    EXPECT_EQ(searched.list_builds(), calls);
+    EXPECT_GE(listed.list_builds(), 4) << v.describe();  // the first call, the period, the cell, the cutoff
+    EXPECT_LT(listed.list_builds(), calls / 2) << v.describe();
+  }
+}
+
 // A vertex's contact force is summed over its partners in row order: a far cell appended to the
 // rows (which moves the bins of the axes without a period) leaves every other force unchanged bit
 // for bit, and so does leaving out a cell that touches no other (rows keep their order). This is

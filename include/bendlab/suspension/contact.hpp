@@ -15,6 +15,15 @@
 // nearest periodic image (the image in the neighbour bin, or Vessel::minimum_image where an axis
 // has fewer than three bins), so positions may be unwrapped. ContactSearch
 // keeps its bins between calls: once warm it allocates nothing.
+//
+// Verlet list. add_cell_contact keeps the pairs of different cells closer than r_c + skin (skin =
+// kSkinFraction r_c) and searches the bins again only when some vertex has moved more than skin / 2
+// since (or the rows, their cells or the law changed): until then every pair closer than r_c is
+// in the list. The forces are a function of the positions alone, bit for bit those of the search
+// in every call (add_cell_contact_reference, kept as the reference), whenever the list was
+// rebuilt.
+#include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "bendlab/core/types.hpp"
@@ -46,6 +55,14 @@ class ContactSearch {
   /// image taken from either end).
   double add_cell_contact(const Vessel& vessel, const ContactLaw& law, const Points& x,
                           const std::vector<int>& cell_of, Points& F);
+  /// The same with the bins searched in every call and no list kept: the reference of the Verlet
+  /// list. Forces equal add_cell_contact's bit for bit; the energy is summed in another order.
+  double add_cell_contact_reference(const Vessel& vessel, const ContactLaw& law, const Points& x,
+                                    const std::vector<int>& cell_of, Points& F);
+  /// The Verlet list's skin as a fraction of the cutoff.
+  static constexpr double kSkinFraction = 0.3;
+  /// How often the pairs were searched for again (diagnostic; every call of the reference counts).
+  std::int64_t list_builds() const { return list_builds_; }
   /// The smallest distance between vertices of different cells closer than `range` (range if
   /// none): a diagnostic of how near the cells came.
   double min_cell_distance(const Vessel& vessel, const Points& x, const std::vector<int>& cell_of, double range);
@@ -71,6 +88,16 @@ class ContactSearch {
   };
   std::vector<Partner> partners_;  // of one vertex i
   Points wrapped_, sorted_;
+  // The Verlet list: the partners of row i are list_row_[list_start_[i] .. list_start_[i + 1]),
+  // ascending, found at the positions list_x_ (unwrapped) with the cells list_cell_.
+  bool list_is_current(const Vessel& vessel, const ContactLaw& law, const Points& x, const std::vector<int>& cell_of) const;
+  void build_list(const Vessel& vessel, const ContactLaw& law, const Points& x, const std::vector<int>& cell_of);
+  std::vector<int> list_start_, list_row_, list_cell_;
+  std::vector<std::pair<int, int>> found_;  // (i, j) while building
+  Points list_x_;
+  double list_cutoff_ = 0;
+  Vec3 list_period_ = Vec3::Zero();
+  std::int64_t list_builds_ = 0;
 };
 
 }  // namespace bendlab

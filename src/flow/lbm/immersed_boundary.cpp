@@ -172,14 +172,24 @@ void IbInterpolator::interpolate(const Lattice& lattice, Points& U) {
   for (std::size_t w = 0; w < marks_.size(); ++w)
     for (std::uint64_t bits = marks_[w]; bits != 0; bits &= bits - 1)
       touched_.push_back(64 * w + static_cast<std::size_t>(__builtin_ctzll(bits)));
-  // Their velocities, then each node's stencil sum.
+  // Their velocities, a run of consecutive touched nodes of one x-row at a time
+  // (Lattice::velocities_of_run: velocity() bit for bit, the run's slots read together), then
+  // each node's stencil sum.
   if (velocity_.size() != 3 * n) velocity_.assign(3 * n, 0.0);
-  const auto touched = static_cast<std::ptrdiff_t>(touched_.size());
-#pragma omp parallel for schedule(static) if (touched >= 4096)
-  for (std::ptrdiff_t t = 0; t < touched; ++t) {
-    const std::size_t node = touched_[static_cast<std::size_t>(t)];
-    const Vec3 v = lattice.velocity(node);
-    velocity_[3 * node] = v.x(), velocity_[3 * node + 1] = v.y(), velocity_[3 * node + 2] = v.z();
+  const std::size_t nx = static_cast<std::size_t>(lattice.nx());
+  runs_.clear();
+  for (std::size_t t = 0; t < touched_.size();) {
+    const std::size_t first = touched_[t], row_end = (first / nx + 1) * nx;
+    std::size_t end = t + 1;
+    while (end < touched_.size() && touched_[end] == touched_[end - 1] + 1 && touched_[end] < row_end) ++end;
+    runs_.push_back({first, static_cast<int>(end - t)});
+    t = end;
+  }
+  const auto runs = static_cast<std::ptrdiff_t>(runs_.size());
+#pragma omp parallel for schedule(static) if (touched_.size() >= 4096)
+  for (std::ptrdiff_t r = 0; r < runs; ++r) {
+    const Run& run = runs_[static_cast<std::size_t>(r)];
+    lattice.velocities_of_run(run.first, run.count, velocity_.data() + 3 * run.first);
   }
   U.resize(nodes_, 3);
 #pragma omp parallel for schedule(static) if (nodes_ >= 1024)

@@ -879,6 +879,104 @@ Vec3 Lattice::velocity(std::size_t node) const {
   return (j + 0.5 * (force(node) + config_.body_force)) / rho;
 }
 
+namespace {
+
+// velocities_of_run's sums for nodes t and t + 1 (t only with lanes = 1), from slot q on: rho and j
+// of velocity(), leaving out the terms with c = 0 (adding f * 0 to a sum that starts at +0 never
+// changes it) and subtracting for c = -1 (j + f * (-1) is j - f exactly).
+template <int q>
+[[gnu::always_inline]] inline void add_moments(const double* const* p, int t, double* rho, double* jx, double* jy, double* jz, int lanes = 2) {
+  if constexpr (q < kQ) {
+    for (int k = 0; k < 2; ++k) {
+      const double v = k < lanes ? p[q][t + k] : 0.0;
+      rho[k] += v;
+      if constexpr (kCx[q] == 1) jx[k] += v;
+      if constexpr (kCx[q] == -1) jx[k] -= v;
+      if constexpr (kCy[q] == 1) jy[k] += v;
+      if constexpr (kCy[q] == -1) jy[k] -= v;
+      if constexpr (kCz[q] == 1) jz[k] += v;
+      if constexpr (kCz[q] == -1) jz[k] -= v;
+    }
+    add_moments<q + 1>(p, t, rho, jx, jy, jz, lanes);
+  }
+}
+
+}  // namespace
+
+void Lattice::velocities_of_run(std::size_t node, int count, double* u) const {
+  const std::size_t nx = static_cast<std::size_t>(config_.nx);
+  const std::size_t row = node / nx;
+  const int i0 = static_cast<int>(node - row * nx);
+  if (count < 0 || i0 + count > config_.nx) throw Error(fmt::format("lattice: a run of {} nodes from x = {} leaves its row", count, i0));
+  if (solid_row(static_cast<int>(row % static_cast<std::size_t>(config_.ny)), static_cast<int>(row / static_cast<std::size_t>(config_.ny)))) {
+    std::fill_n(u, 3 * count, 0.0);  // the resting wall, as velocity()
+    return;
+  }
+  // velocity()'s arithmetic node by node, a chunk of the run at a time. The 19 populations of the
+  // chunk's nodes are found first (contiguous in each slot, but for the x-wrap of an odd step at
+  // the row's two ends, copied to a buffer), then each node's moments are summed over q in
+  // velocity()'s order in registers. Terms with c = 0 are left out and c = -1 subtracts: the
+  // sums start at +0, so adding f * 0 never changes them, and j + f * (-1) is j - f exactly.
+  constexpr int kChunk = 64;
+  double buffer[kQ][kChunk];
+  const double* p[kQ];
+  const std::int32_t* source = pull_rows_.data() + row * kQ;
+  const bool odd = step_ % 2 == 1;
+  for (int c0 = 0; c0 < count; c0 += kChunk) {
+    const int m = std::min(kChunk, count - c0);
+    const int i = i0 + c0;  // x of the chunk's first node
+    const std::size_t first = row * nx + static_cast<std::size_t>(i);
+    for (int q = 0; q < kQ; ++q) {
+      p[q] = f_.data() + q * stride_ + first;  // even step, solid source, wall
+      const std::int32_t r = odd ? source[q] : kPullSolid;
+      if (r >= 0) {
+        // Slot qbar of the source row at x - c_qx, wrapped along x.
+        const double* src = f_.data() + opposite(q) * stride_ + static_cast<std::size_t>(r) * nx;
+        if (i - kCx[q] >= 0 && i + m - 1 - kCx[q] < config_.nx) {
+          p[q] = src + (i - kCx[q]);
+        } else {
+          for (int t = 0; t < m; ++t) {
+            int is = i + t - kCx[q];
+            is = is < 0 ? is + config_.nx : (is >= config_.nx ? is - config_.nx : is);
+            buffer[q][t] = src[is];
+          }
+          p[q] = buffer[q];
+        }
+      } else if (r != kPullSolid) {
+        const double uw = r == kPullBottomWall ? -config_.wall_velocity : config_.wall_velocity;
+        for (int t = 0; t < m; ++t) buffer[q][t] = p[q][t] + 6.0 * kW[q] * kCx[q] * uw;
+        p[q] = buffer[q];
+      }
+    }
+    const double* Fx = force_.data() + first;
+    const double* Fy = Fx + stride_;
+    const double* Fz = Fy + stride_;
+    const Vec3& g = config_.body_force;
+    // Each node's sums over q in velocity()'s order, nodes in pairs (a vector's lanes): all 19
+    // slots advance together along the run, as in the collision kernel, which the hardware's
+    // prefetch follows.
+    int t = 0;
+    for (; t + 2 <= m; t += 2) {
+      double rho[2] = {0.0, 0.0}, jx[2] = {0.0, 0.0}, jy[2] = {0.0, 0.0}, jz[2] = {0.0, 0.0};
+      add_moments<0>(p, t, rho, jx, jy, jz);
+      for (int k = 0; k < 2; ++k) {
+        double* ut = u + 3 * (c0 + t + k);
+        ut[0] = (jx[k] + 0.5 * (Fx[t + k] + g.x())) / rho[k];
+        ut[1] = (jy[k] + 0.5 * (Fy[t + k] + g.y())) / rho[k];
+        ut[2] = (jz[k] + 0.5 * (Fz[t + k] + g.z())) / rho[k];
+      }
+    }
+    for (; t < m; ++t) {
+      double rho[2] = {0.0, 0.0}, jx[2] = {0.0, 0.0}, jy[2] = {0.0, 0.0}, jz[2] = {0.0, 0.0};
+      add_moments<0>(p, t, rho, jx, jy, jz, 1);
+      double* ut = u + 3 * (c0 + t);
+      ut[0] = (jx[0] + 0.5 * (Fx[t] + g.x())) / rho[0];
+      ut[1] = (jy[0] + 0.5 * (Fy[t] + g.y())) / rho[0];
+      ut[2] = (jz[0] + 0.5 * (Fz[t] + g.z())) / rho[0];
+    }
+  }
+}
+
 double Lattice::total_mass() const {
   double m = 0;
   for (std::size_t node = 0; node < n_; ++node) {

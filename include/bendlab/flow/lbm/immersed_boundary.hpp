@@ -81,6 +81,11 @@ class IbInterpolator {
   std::vector<std::uint64_t> marks_;   // a bit per lattice node: in some stencil
   std::vector<std::size_t> touched_;   // the marked nodes, ascending
   std::vector<double> velocity_;       // 3 per lattice node
+  struct Run {
+    std::size_t first;  // a node
+    int count;          // consecutive nodes of its x-row from it
+  };
+  std::vector<Run> runs_;  // touched_ in runs
 };
 
 /// X <- X + dt U.

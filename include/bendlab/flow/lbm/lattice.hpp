@@ -197,6 +197,10 @@ class Lattice {
   /// u = (sum f c + F/2) / rho with the current force field (and the body force); zero at a node
   /// in the solid of the cross-section (the resting wall, which the immersed boundary then sees).
   Vec3 velocity(std::size_t node) const;
+  /// velocity() of the `count` consecutive nodes node, node + 1, ... of one x-row (all in the row
+  /// of `node`), bit for bit, written to u as x, y, z per node. A population slot is read for the
+  /// whole run at once, so the loop over the run vectorises: the gather of the immersed boundary.
+  void velocities_of_run(std::size_t node, int count, double* u) const;
   /// Sum of rho, and of sum f c (without F/2), over all fluid nodes.
   double total_mass() const;
   Vec3 total_momentum() const;
