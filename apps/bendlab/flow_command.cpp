@@ -188,6 +188,12 @@ const CommandRegistration flow_registration([](CLI::App& app) {
   cmd->add_option("--contact-force", args->contact_force_pn,
                   "repulsion force at contact, pN (0: G_s dx, the membrane tension over one dx)")
       ->capture_default_str();
+  cmd->add_option("--membrane-every", s.membrane_every,
+                  "compute the cells' membrane forces (elasticity, bending, volume) every N lattice steps and hold "
+                  "them in between, HemoCell's time-scale separation (its stepMaterialEvery); contact forces and "
+                  "the cells' motion stay every step, reports fall on multiples of N. Its error: "
+                  "docs/results/suspension_performance.md. One process only")
+      ->check(CLI::PositiveNumber)->capture_default_str();
   cmd->add_option("--t-end", args->t_end, "end of the run, s")->capture_default_str();
   cmd->add_option("--sample-every", s.sample_every, "s between time-series rows (whole lattice steps)")
       ->capture_default_str();

@@ -30,7 +30,8 @@ nlohmann::json FlowRunSpec::to_json() const {
     j["height_um"] = u.height_um;
     j["width_um"] = u.width_um;
   }
-  if (u.time_scale != 1) j["time_scale"] = u.time_scale;  // absent when 1: the runs made before it keep theirs
+  if (u.time_scale != 1) j["time_scale"] = u.time_scale;
+  if (membrane_every != 1) j["membrane_every"] = membrane_every;  // absent when 1, as time_scale  // absent when 1: the runs made before it keep theirs
   if (u.pseudo_shear_rate) j["pseudo_shear_rate"] = *u.pseudo_shear_rate;
   if (shear && u.shear_rate) j["shear_rate"] = *u.shear_rate;
   if (u.body_force) j["body_force"] = *u.body_force;
@@ -54,6 +55,7 @@ const FlowRunSpec& checked(const FlowRunSpec& s) {
     throw Error(fmt::format("--sample-every {} s must be positive", s.sample_every));
   if (!(s.steady_from >= 0 && s.steady_from < 1))
     throw Error(fmt::format("--steady-from {} must lie in [0, 1)", s.steady_from));
+  if (s.membrane_every < 1) throw Error(fmt::format("--membrane-every {} must be at least 1", s.membrane_every));
   if (!(s.slice_width_um > 0) || !std::isfinite(s.slice_width_um))
     throw Error(fmt::format("--slice-width {} um must be positive", s.slice_width_um));
   return s;
@@ -141,6 +143,7 @@ FlowRun::FlowRun(const FlowRunSpec& spec, const std::function<void(const std::st
   const double force_lattice = units_.to_lattice_force(contact_force);
   o.suspension.cell_contact = ContactLaw{force_lattice, cutoff_um / dx};
   o.suspension.wall_contact = ContactLaw{force_lattice, cutoff_um / dx};
+  o.suspension.membrane_every = spec_.membrane_every;
   o.dx_um = dx;
   o.dt_seconds = units_.dt;
   o.sample_every = spec_.sample_every;
@@ -238,6 +241,11 @@ std::vector<std::string> FlowRun::describe() const {
                               spec_.cell.shear_modulus, spec_.cell.bending_modulus, spec_.cell.method,
                               shear ? "volume fraction" : "tube hematocrit", placement_.hematocrit,
                               shear ? "eta gamma R / G_s" : "eta (v/D) R / G_s", ca));
+  lines.push_back(spec_.membrane_every == 1
+                      ? std::string("membrane forces every lattice step (--membrane-every 1)")
+                      : fmt::format("membrane forces every {} lattice steps, held in between (--membrane-every); "
+                                    "contacts and motion every step; reports every {} steps",
+                                    spec_.membrane_every, solver_->sample_steps()));
   return lines;
 }
 
@@ -256,6 +264,7 @@ CapsuleRunResult FlowRun::run(CapsuleRunOptions options) {
   options.time_name = "t (s)";
   options.summary_fields["achieved_hematocrit_placed"] = placement_.hematocrit;
   options.summary_fields["relax_steps"] = relax_steps_;
+  options.summary_fields["membrane_every"] = spec_.membrane_every;
   options.summary_fields["dt_s"] = units_.dt;
   options.summary_fields["mach"] = units_.mach;
   options.summary_fields["reynolds"] = units_.reynolds;

@@ -23,6 +23,10 @@ const SuspensionSolverOptions& checked(const SuspensionSolverOptions& o) {
 SuspensionSolver::SuspensionSolver(SuspensionSolverOptions options)
     : options_(checked(options)),
       sample_steps_(std::max<std::int64_t>(1, std::llround(options_.sample_every / options_.dt_seconds))) {
+  // Reports (and so checkpoints) at steps where the held membrane forces are renewed: a run
+  // resumed there repeats the uninterrupted one.
+  const std::int64_t every = options_.suspension.membrane_every;
+  if (every > 1) sample_steps_ = (sample_steps_ + every - 1) / every * every;
   x_.resize(0, 3);
   u_.resize(0, 3);
 }

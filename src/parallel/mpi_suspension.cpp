@@ -37,7 +37,11 @@ std::vector<double> all_to_all(const std::vector<std::vector<double>>& send, MPI
 }  // namespace
 
 MpiSuspension::MpiSuspension(lbm::SuspensionOptions options, MPI_Comm comm)
-    : options_(lbm::checked_suspension_options(std::move(options))), fluid_(options_.lattice, comm) {}
+    : options_(lbm::checked_suspension_options(std::move(options))), fluid_(options_.lattice, comm) {
+  // A cell that moves to another rank would leave its held membrane forces behind.
+  if (options_.membrane_every != 1)
+    throw Error(fmt::format("membrane forces every {} steps: the MPI suspension computes them every step; run with one process", options_.membrane_every));
+}
 
 int MpiSuspension::add_cell(std::shared_ptr<const MembraneModel> membrane, const Points& X) {
   const int c = num_cells();

@@ -116,6 +116,29 @@ TEST_F(Cli, FlowTimeScaleIsTheDensityScaledRunAndRefusesAReynoldsNumberAboveItsB
                  "--time-scale 250: the Reynolds number", out);
 }
 
+TEST_F(Cli, FlowMembraneEveryIsRecordedResumesAsTheUninterruptedRunAndRefusesZero) {
+  // --membrane-every 4: said on stderr, in the run's identity and summary; a run stopped and
+  // resumed from its checkpoint ends as the uninterrupted one (reports fall on multiples of 4, where
+  // the held forces are renewed).
+  const fs::path whole = dir / "whole", parts = dir / "parts", out = dir / "r";
+  CliRun r = run("flow --cells 2 --membrane-every 4" + kSmallTube + " --out " + whole.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out).at("membrane_every").get<int>(), 4);
+  EXPECT_NE(r.err.find("membrane forces every 4 lattice steps"), std::string::npos) << r.err;
+  r = run("flow --cells 2 --membrane-every 4 --stop-after-steps 5" + kSmallTube + " --out " + parts.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  r = run("flow --cells 2 --membrane-every 4 --resume" + kSmallTube + " --out " + parts.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(slurp(parts / "timeseries.csv"), slurp(whole / "timeseries.csv"));
+  EXPECT_EQ(checkpoint_positions(parts), checkpoint_positions(whole));
+  // Every step is the default, and a resume must name the same N.
+  r = run("flow --cells 2 --resume" + kSmallTube + " --out " + whole.string());
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.err.find("membrane_every"), std::string::npos) << r.err;
+  expect_refused(run("flow --hematocrit 0 --membrane-every 0" + kSmallTube + " --out " + out.string()), "--membrane-every",
+                 out);
+}
+
 TEST_F(Cli, FlowWritesNoNonFiniteNumber) {
   // Without cells there is no cell-free layer: an empty field, not "nan".
   for (const char* cells : {"--cells 0", "--hematocrit 0"}) {

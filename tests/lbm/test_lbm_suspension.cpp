@@ -189,6 +189,52 @@ TEST(LbmSuspension, ThreadCountDoesNotChangeTheRun) {
   EXPECT_EQ(one, two);
 }
 
+// --membrane-every N: the membrane forces of steps 1 .. N are those of the positions before step 1,
+// those of steps N + 1 .. 2N those before step N + 1, bit for bit; N = 1 is the suspension of
+// every step. A suspension restored at a step the forces are renewed repeats the uninterrupted run.
+TEST(LbmSuspension, MembraneForcesEveryNStepsAreHeldFromTheStepThatRenewedThem) {
+  auto make = [](int every) {
+    SuspensionOptions o;
+    o.lattice.nx = 20;
+    o.lattice.ny = 14;
+    o.lattice.nz = 14;
+    o.lattice.walls = false;
+    o.lattice.collision = Collision::TRT;
+    o.lattice.tau = 0.9;
+    o.vessel = Vessel::box(1e9, 14, 20);
+    o.membrane_every = every;
+    auto s = std::make_unique<LbmSuspension>(o);
+    s->lattice().initialise([](const Vec3& x) { return Vec3(0.01 * std::sin(0.3 * x.z()), 0, 0.005); });
+    const auto m = rbc(3.5, 0.005);
+    s->add_cell(m, moved(m->reference_positions() * 1.05, Vec3(0, 0, 0), 0.3));  // stretched: elastic forces act
+    return s;
+  };
+  auto membrane_forces = [](const LbmSuspension& s) {
+    Points f;
+    s.membrane(0).forces(s.cell_positions(0), f);
+    return f;
+  };
+  const int N = 3;
+  auto held = make(N), every = make(1);
+  EXPECT_THROW(make(0), Error);
+  Points renewed = membrane_forces(*held);
+  for (int step = 1; step <= 3 * N; ++step) {
+    if ((step - 1) % N == 0) renewed = membrane_forces(*held);
+    const Points expected_every = membrane_forces(*every);
+    held->step();
+    every->step();
+    ASSERT_EQ(held->forces(), renewed) << "step " << step;
+    ASSERT_EQ(every->forces(), expected_every) << "step " << step;
+  }
+  EXPECT_GT((held->positions() - every->positions()).cwiseAbs().maxCoeff(), 0.0);  // holding changes the run
+  // Restored after 2N steps into a fresh suspension: the same as running on.
+  auto resumed = make(N);
+  resumed->restore(held->lattice(), held->positions());
+  held->run(N + 1);
+  resumed->run(N + 1);
+  EXPECT_EQ(resumed->positions(), held->positions());
+}
+
 // The shear box's moving walls repel as a channel's resting ones do: a cell pushed towards the top
 // wall comes to rest on the repulsion, no vertex crosses the wall, and the immersed boundary's
 // kernel never reaches it (which the lattice would refuse).

@@ -50,6 +50,8 @@ struct FlowRunSpec {
   double sample_every = 1e-4;          ///< s between time-series rows
   double steady_from = 0.5;            ///< the steady window starts at steady_from t_end
   double slice_width_um = 1;           ///< the cell-free layer's slices along x
+  /// Membrane forces every this many lattice steps, held in between (lbm::SuspensionOptions).
+  int membrane_every = 1;
 
   /// The run's identity (checkpoint "arguments"): every field that changes its results.
   nlohmann::json to_json() const;

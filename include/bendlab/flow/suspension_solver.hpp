@@ -66,7 +66,8 @@ class SuspensionSolver : public CapsuleSolver {
   bool is_side_file(const std::string& name) const final;
 
   const SuspensionSolverOptions& options() const { return options_; }
-  /// Lattice steps between reports.
+  /// Lattice steps between reports: sample_every in steps, rounded up to a multiple of
+  /// suspension.membrane_every.
   std::int64_t sample_steps() const { return sample_steps_; }
 
   /// Adds a cell at positions X in um (lattice units inside; every process adds the same cells in

@@ -15,6 +15,7 @@ SuspensionOptions checked_suspension_options(SuspensionOptions o) {
   o.cell_contact.validate();
   o.wall_contact.validate();
   if (!o.vertex_force.allFinite()) throw Error("suspension: the force per vertex is not finite");
+  if (o.membrane_every < 1) throw Error(fmt::format("suspension: membrane forces every {} steps: must be at least 1", o.membrane_every));
   const LatticeConfig& c = o.lattice;
   if (std::abs(o.vessel.length() - c.nx) > 1e-9 || (o.vessel.periodic(1) && std::abs(o.vessel.width() - c.ny) > 1e-9)) {
     throw Error(fmt::format("suspension: the {} does not match the lattice's periods ({} x {} nodes)", o.vessel.describe(), c.nx, c.ny));
@@ -44,6 +45,7 @@ int LbmSuspension::add_cell(std::shared_ptr<const MembraneModel> membrane, const
   cell_of_.resize(X_.rows(), c);
   F_.setZero(X_.rows(), 3);
   U_.setZero(X_.rows(), 3);
+  held_step_ = -1;
   return c;
 }
 
@@ -55,16 +57,23 @@ void LbmSuspension::restore(Lattice lattice, const Points& X) {
     throw Error(fmt::format("suspension: {} restored positions for {} vertices", X.rows(), X_.rows()));
   lattice_ = std::move(lattice);
   X_ = X;
+  held_step_ = -1;
 }
 
 void LbmSuspension::step() {
   const std::int64_t n = lattice_.step_count() + 1;
   try {
     // 1. Forces at X(t), a cell per thread (a membrane model is safe to share between threads);
-    // the first error is rethrown after the loop.
-    const int threads = cells_.size() > 1 ? omp_get_max_threads() : 1;
+    // the first error is rethrown after the loop. With membrane_every N > 1 the membrane forces
+    // are computed at the steps n - 1 = 0 mod N (or first after add_cell and restore) and held.
+    const int every = options_.membrane_every;
+    const bool hold = every > 1;
+    const bool fresh = !hold || held_step_ < 0 || (n - 1) % every == 0;
+    Points& membrane_forces = hold ? held_membrane_ : F_;
+    if (hold) membrane_forces.resize(X_.rows(), 3);
+    const int threads = fresh && cells_.size() > 1 ? omp_get_max_threads() : 1;
     if (static_cast<int>(scratch_.size()) < threads) scratch_.resize(static_cast<std::size_t>(threads));
-    const auto cells = static_cast<std::ptrdiff_t>(cells_.size());
+    const auto cells = fresh ? static_cast<std::ptrdiff_t>(cells_.size()) : 0;
     std::string failure;
 #pragma omp parallel for schedule(dynamic) num_threads(threads) if (threads > 1)
     for (std::ptrdiff_t c = 0; c < cells; ++c) {
@@ -74,13 +83,17 @@ void LbmSuspension::step() {
         const Eigen::Index rows = cell.membrane->num_vertices();
         s.x = X_.middleRows(cell.first, rows);
         cell.membrane->forces(s.x, s.f);
-        F_.middleRows(cell.first, rows) = s.f;
+        membrane_forces.middleRows(cell.first, rows) = s.f;
       } catch (const Error& e) {
 #pragma omp critical
         if (failure.empty()) failure = fmt::format("cell {}: {}", c, e.what());
       }
     }
     if (!failure.empty()) throw Error(failure);
+    if (hold) {
+      if (fresh) held_step_ = n - 1;
+      F_ = held_membrane_;
+    }
     if (options_.vertex_force != Vec3::Zero()) F_.rowwise() += options_.vertex_force.transpose();
     cell_contact_energy_ = wall_contact_energy_ = 0;
     if (options_.cell_contact.max_force > 0 && cells_.size() > 1) {

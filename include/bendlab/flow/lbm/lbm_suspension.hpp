@@ -36,6 +36,11 @@ struct SuspensionOptions {
   ContactLaw cell_contact{0, 1};  ///< between vertices of different cells (max_force 0: none)
   ContactLaw wall_contact{0, 1};  ///< between a vertex and the wall
   Vec3 vertex_force = Vec3::Zero();  ///< an external force on every vertex (sedimentation, a push)
+  /// The cells' membrane forces (elasticity, bending, volume) are computed at the steps whose
+  /// count before the step is a multiple of this and held in between, as HemoCell's
+  /// stepMaterialEvery; contact and external forces, the spreading and the move stay every step.
+  /// 1: every step. One process only (the MPI suspension refuses more).
+  int membrane_every = 1;
 };
 
 /// The options as LbmSuspension takes them; throws bendlab::Error for a bad lattice or contact
@@ -76,6 +81,8 @@ class LbmSuspension {
   Points cell_positions(int c) const { return X_.middleRows(first_row(c), rows(c)); }
   /// The vertex velocities of the last step.
   const Points& velocities() const { return U_; }
+  /// The vertex forces the last step spread (membrane, external and contact forces).
+  const Points& forces() const { return F_; }
   /// The cell of each row of positions().
   const std::vector<int>& cell_of_row() const { return cell_of_; }
   const Lattice& lattice() const { return lattice_; }
@@ -98,6 +105,10 @@ class LbmSuspension {
   std::vector<Cell> cells_;
   std::vector<int> cell_of_;
   Points X_, F_, U_;
+  // The held membrane forces (membrane_every > 1) and the step count at which they were computed
+  // (-1: none, after add_cell and restore).
+  Points held_membrane_;
+  std::int64_t held_step_ = -1;
   struct Scratch {
     Points x, f;  // one cell's positions and forces
   };
