@@ -12,6 +12,8 @@
 //                        26 (1 rank) and 48 (2 ranks) steps/s on this kind of machine;
 //   BM_PipeflowFluid     the fluid step alone (the same lattice, no cells): cells_fraction of the
 //                        whole step = 1 - fluid / step, computed by scripts from the two.
+//   BM_Tube10Step        the tube study's reference case at time scale 10 (D = 10 um, 5 red blood
+//                        cells, tau 1.82; pipeflow_case.hpp), and BM_Tube10Fluid its fluid alone;
 //   BM_PipeflowHt03Step  the same tube at tube hematocrit 0.3 (red blood cells only, placed by
 //                        place_cells from seed 1 with the same clearance: 79 cells, grown from 0.6
 //                        of their size where random addition jams at 47).
@@ -69,6 +71,30 @@ void BM_PipeflowFluid(benchmark::State& state) {
                                                benchmark::Counter::kIsRate);
 }
 
+// The tube study's reference case at time scale 10 (pipeflow_case.hpp: tube10_options), the
+// fluid alone and the whole step.
+void BM_Tube10Step(benchmark::State& state) {
+  omp_set_num_threads(static_cast<int>(state.range(0)));
+  static std::unique_ptr<LbmSuspension> s;
+  if (!s) {
+    s = std::make_unique<LbmSuspension>(bench::tube10_options());
+    bench::add_tube10_cells(*s);
+  }
+  s->run(2);
+  for (auto _ : state) s->step();
+  state.counters["steps_per_second"] = benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["cells"] = s->num_cells();
+  state.counters["vertices"] = static_cast<double>(s->positions().rows());
+}
+
+void BM_Tube10Fluid(benchmark::State& state) {
+  omp_set_num_threads(static_cast<int>(state.range(0)));
+  static std::unique_ptr<LbmSuspension> s = std::make_unique<LbmSuspension>(bench::tube10_options());
+  s->run(2);
+  for (auto _ : state) s->step();
+  state.counters["steps_per_second"] = benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+}
+
 void BM_PipeflowHt03Step(benchmark::State& state) {
   omp_set_num_threads(static_cast<int>(state.range(0)));
   static std::unique_ptr<LbmSuspension> s;
@@ -119,6 +145,8 @@ void BM_ExtraCellMemory(benchmark::State& state) {
 
 BENCHMARK(BM_PipeflowFluid)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_PipeflowStep)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Tube10Fluid)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Tube10Step)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_PipeflowHt03Step)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ExtraCellMemory)->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK_MAIN();

@@ -13,26 +13,58 @@ namespace bendlab::bench {
 
 using namespace bendlab::lbm;
 
-inline FlowUnits pipeflow_units() {
+// A tube of diameter D and length L (um) at dx = 0.5 um and relaxation time tau, driven at a
+// pseudo-shear rate of 100 1/s, with the lattice density `time_scale` times the plasma's.
+inline FlowUnits tube_units(double diameter_um, double length_um, double tau, double time_scale = 1.0) {
   FlowUnitsInput in;
   in.geometry = FlowGeometry::Tube;
-  in.diameter_um = 25;
-  in.length_um = 50;
+  in.diameter_um = diameter_um;
+  in.length_um = length_um;
   in.dx_um = 0.5;
-  in.tau = 1.0;
+  in.tau = tau;
   in.pseudo_shear_rate = 100;
+  in.time_scale = time_scale;
   return flow_units(in);
 }
 
-inline SuspensionOptions pipeflow_options() {
-  const FlowUnits u = pipeflow_units();
+inline FlowUnits pipeflow_units() { return tube_units(25, 50, 1.0); }
+
+// The suspension options of a tube: contact with the force `contact_newton` at contact and a
+// cutoff of one dx, between cells and at the wall.
+inline SuspensionOptions tube_options(const FlowUnits& u, double contact_newton) {
   SuspensionOptions o;
   o.lattice = flow_lattice_config(u);
   o.vessel = Vessel::tube(u.section_lattice, u.nx);
   const double cutoff = 1.0;
-  o.cell_contact = ContactLaw{u.to_lattice_force(1e-12), cutoff};
-  o.wall_contact = ContactLaw{u.to_lattice_force(1e-12), cutoff};
+  o.cell_contact = ContactLaw{u.to_lattice_force(contact_newton), cutoff};
+  o.wall_contact = ContactLaw{u.to_lattice_force(contact_newton), cutoff};
   return o;
+}
+
+inline SuspensionOptions pipeflow_options() { return tube_options(pipeflow_units(), 1e-12); }
+
+// The tube study's reference case (scripts/tube_study.py, docs/results/tube_flow.md) as
+// `bendlab flow` runs it at time scale 10: D = 10 um, 20 um periodic, tau = 1.82, red blood cells
+// (mt1:1280, Method C, Skalak) at tube hematocrit 0.3 placed from seed 1 with flow's clearance
+// (half the cutoff) and contact force (G_s dx): 40 x 24 x 24 nodes and 5 cells.
+inline FlowUnits tube10_units() { return tube_units(10, 20, 1.82, 10.0); }
+
+inline SuspensionOptions tube10_options() {
+  const CellKindSpec rbc;
+  return tube_options(tube10_units(), rbc.shear_modulus * 0.5e-6);
+}
+
+template <class S>
+void add_tube10_cells(S& s) {
+  const FlowUnits u = tube10_units();
+  const CellKind rbc = make_cell_kind(CellKindSpec{});
+  PlacementOptions p;
+  p.hematocrit = 0.3;
+  p.clearance = 0.25;
+  p.seed = 1;
+  const Placement reds = place_cells(Vessel::tube(10, 20), rbc.reference_um.topology(), rbc.reference_um.positions(), p);
+  const auto membrane = lattice_membrane(rbc, u);
+  for (const PlacedCell& c : reds.cells) s.add_cell(membrane, placed_positions(rbc.reference_um.positions(), c) / u.input.dx_um);
 }
 
 // The cells of the case: 36 red blood cells (or the count of `hematocrit`, red cells only) and 6

@@ -4,6 +4,7 @@ per extra cell (issue "Many cells in channel and tube flow", benchmark).
 
     /usr/bin/python3 scripts/make_suspension_performance_doc.py [--bench build/release/bench_suspension]
                                                                 [--runs N] [--json FILE ...]
+                                                                [--before BENCH] [--before-json FILE ...]
                                                                 [--out docs/results/suspension_performance.md]
 
 Runs bench/bench_suspension.cpp (Google Benchmark, JSON) --runs times (default 3, each a fresh
@@ -15,7 +16,13 @@ and 6 small stiff cells, every force updated every step):
     times those;
   - the cells' share of a step, 1 - (fluid step alone) / (whole step), target at most one half;
   - the same tube at tube hematocrit 0.3 (placement permitting);
-  - the heap in use per added cell against positions and forces alone (48 bytes per vertex).
+  - the heap in use per added cell against positions and forces alone (48 bytes per vertex);
+  - the whole step in fluid steps on the pipeflow case and on the tube study's reference case
+    (D = 10 um, 5 cells, time scale 10), on 1 and 2 threads, and with --before (an older build of
+    bench_suspension, run alternately with this one in the same run) the same before, with the
+    ratios: targets at most 4.2 fluid steps on the pipeflow case and 1.7 times the one-thread step
+    on two threads;
+  - docs/results/membrane_every.md (scripts/membrane_every_study.py), included as it stands.
 Every figure is the median over the runs; the load average before and after is recorded. The
 timings are only as quiet as the machine. Standard library only.
 """
@@ -63,8 +70,11 @@ def main():
     p.add_argument("--bench", default="build/release/bench_suspension")
     p.add_argument("--runs", type=int, default=3)
     p.add_argument("--json", nargs="*", default=None, help="earlier reports instead of running")
+    p.add_argument("--before", default=None, help="an older bench_suspension to set against this one")
+    p.add_argument("--before-json", nargs="*", default=None, help="earlier reports of the older build")
     p.add_argument("--out", default="docs/results/suspension_performance.md")
     a = p.parse_args()
+    before_reports = []
     load_start = load_average()
     reports = []
     if a.json:
@@ -74,11 +84,22 @@ def main():
     else:
         if not os.access(a.bench, os.X_OK):
             sys.exit(f"error: no benchmark program at '{a.bench}' (cmake --build --preset release)")
+        if a.before and not os.access(a.before, os.X_OK):
+            sys.exit(f"error: no benchmark program at '{a.before}' (--before)")
         for k in range(a.runs):
             print(f"make_suspension_performance_doc: run {k + 1} of {a.runs}", flush=True)
             out = subprocess.run([a.bench, "--benchmark_format=json", "--benchmark_min_time=3"],
                                  capture_output=True, text=True, check=True).stdout
             reports.append(json.loads(out))
+            if a.before:
+                out = subprocess.run([a.before, "--benchmark_format=json", "--benchmark_min_time=3",
+                                      "--benchmark_filter=BM_(Pipeflow|Tube10)(Step|Fluid)/"],
+                                     capture_output=True, text=True, check=True).stdout
+                before_reports.append(json.loads(out))
+    if a.before_json:
+        for path in a.before_json:
+            with open(path) as f:
+                before_reports.append(json.load(f))
     load_end = load_average()
     m = medians(reports)
     def ms(row):  # every benchmark of bench_suspension reports milliseconds
@@ -117,6 +138,40 @@ def main():
             L.append(f"| {t} | not placed: {row['error']} | - | - |")
         else:
             L.append(f"| {t} | {row['steps_per_second']:.1f} | {row['cells']:.0f} | {row['vertices']:.0f} |")
+    # The step in fluid steps, before and after.
+    mb = medians(before_reports) if before_reports else {}
+    L += ["", "## The step in fluid steps", "",
+          "CPU cost of a whole step over that of the fluid step alone on the same lattice (real time, one "
+          "process), on the pipeflow case above and on the tube study's reference case (D = 10 um, 20 um periodic, "
+          "tau = 1.82, 5 red blood cells of 1280 triangles, time scale 10: 40 x 24 x 24 nodes). "
+          + ("Before: the build given as --before, run alternately with this one in the same run. "
+             if before_reports else "No earlier build was measured in this run. ")
+          + "Targets: the pipeflow step at most 4.2 fluid steps on one thread; two threads at least 1.7 times "
+            "one.", "",
+          "| case | threads | " + ("step before (ms) | fluid steps before | " if before_reports else "")
+          + "step (ms) | fluid (ms) | fluid steps | " + ("speed-up | " if before_reports else "")
+          + "2 threads / 1 |",
+          "|---|---|" + ("---|---|" if before_reports else "") + "---|---|---|" + ("---|" if before_reports else "")
+          + "---|"]
+    for case, family in (("pipeflow", "Pipeflow"), ("D = 10 um tube", "Tube10")):
+        for t in (1, 2):
+            step, fluid = m.get((f"BM_{family}Step", t)), m.get((f"BM_{family}Fluid", t))
+            if not step or "error" in step or not fluid or "error" in fluid:
+                L.append(f"| {case} | {t} | not measured |")
+                continue
+            cells = [case, str(t)]
+            b_step, b_fluid = mb.get((f"BM_{family}Step", t)), mb.get((f"BM_{family}Fluid", t))
+            if before_reports:
+                if b_step and b_fluid and "error" not in b_step and "error" not in b_fluid:
+                    cells += [f"{ms(b_step):.2f}", f"{ms(b_step) / ms(b_fluid):.2f}"]
+                else:
+                    cells += ["-", "-"]
+            cells += [f"{ms(step):.2f}", f"{ms(fluid):.2f}", f"{ms(step) / ms(fluid):.2f}"]
+            if before_reports:
+                cells.append(f"{ms(b_step) / ms(step):.2f}" if b_step and "error" not in b_step else "-")
+            one = m.get((f"BM_{family}Step", 1))
+            cells.append(f"{ms(one) / ms(step):.2f}" if t == 2 and one and "error" not in one else "")
+            L.append("| " + " | ".join(cells) + " |")
     mem = m.get(("BM_ExtraCellMemory", None))
     L += ["", "Memory per extra cell (the heap in use, glibc's mallinfo2, grown when 20 red blood cells of 642 "
           "vertices join the pipeflow case and it steps twice):", ""]
@@ -129,6 +184,11 @@ def main():
     else:
         L += ["not measured", ""]
     L += ["Where a target is not met, the reason is in docs/design.md (\"Many cells: where the time goes\").", ""]
+    held = os.path.join(os.path.dirname(a.out) or ".", "membrane_every.md")
+    if os.path.exists(held):
+        with open(held) as f:
+            lines = f.read().splitlines()
+        L += ["## " + lines[0].lstrip("# ") + " (docs/results/membrane_every.md, included)", ""] + lines[1:]
     os.makedirs(os.path.dirname(a.out) or ".", exist_ok=True)
     tmp = a.out + ".tmp"
     with open(tmp, "w") as f:

@@ -46,10 +46,23 @@ void ContactSearch::bin(const Vessel& vessel, const Points& x, const std::vector
       w_[a] = period[a] / nb_[a];
     } else {
       const double lo = n > 0 ? x.col(a).minCoeff() : 0.0, hi = n > 0 ? x.col(a).maxCoeff() : 0.0;
-      nb_[a] = std::max(1, std::min(1 << 20, static_cast<int>(std::floor((hi - lo) / width))));
-      lo_[a] = lo;
+      const double fit = std::floor((hi - lo) / width);  // NaN or huge where positions blew up
+      nb_[a] = fit >= 1 ? static_cast<int>(std::min(fit, 1048576.0)) : 1;
+      lo_[a] = std::isfinite(lo) ? lo : 0.0;
       w_[a] = std::max((hi - lo) / nb_[a], width);
     }
+  }
+  // At most about 8 bins per vertex: cells spread far apart along an axis without a period (or a
+  // run blowing up) would otherwise ask for more bins than memory holds. Fewer, wider bins find
+  // the same pairs.
+  const double limit = 8.0 * static_cast<double>(n) + 64.0;
+  while (static_cast<double>(nb_[0]) * nb_[1] * nb_[2] > limit) {
+    int widest = -1;
+    for (int a = 0; a < 3; ++a)
+      if (!vessel.periodic(a) && nb_[a] > 1 && (widest < 0 || nb_[a] > nb_[widest])) widest = a;
+    if (widest < 0) break;  // the periodic axes' bins are bounded by their periods
+    nb_[widest] = (nb_[widest] + 1) / 2;
+    w_[widest] *= 2;
   }
   const std::size_t bins = static_cast<std::size_t>(nb_[0]) * nb_[1] * nb_[2];
   bin_of_.resize(n);
@@ -62,7 +75,8 @@ void ContactSearch::bin(const Vessel& vessel, const Points& x, const std::vector
       double c = x(i, a);
       if (vessel.periodic(a)) c -= period[a] * std::floor((c - lo_[a]) / period[a]);  // into [lo, lo + period)
       wrapped_(i, a) = c;
-      b[a] = std::clamp(static_cast<int>(std::floor((c - lo_[a]) / w_[a])), 0, nb_[a] - 1);
+      const double at = std::floor((c - lo_[a]) / w_[a]);  // clamped before the cast: NaN goes to 0
+      b[a] = at > 0 ? static_cast<int>(std::min(at, static_cast<double>(nb_[a] - 1))) : 0;
     }
     bin_of_[i] = b[0] + nb_[0] * (b[1] + nb_[1] * b[2]);
     ++start_[bin_of_[i] + 1];

@@ -4,6 +4,8 @@
 #include <memory>
 #include <random>
 
+#include <omp.h>
+
 #include "bendlab/flow/lbm/immersed_boundary.hpp"
 #include "bendlab/flow/lbm/section_walls.hpp"
 
@@ -193,14 +195,23 @@ TEST(ImmersedBoundary, SharedNodeInterpolatorEqualsThePlainOne) {  // and its sp
       // Spreading through the prepared stencils: the same force field, bit for bit.
       Points F(X.rows(), 3);
       for (Eigen::Index k = 0; k < X.rows(); ++k) F.row(k) << 1e-4 * std::sin(0.3 * k), 2e-5 * k, -3e-5;
-      Lattice a = L, b = L;
-      a.clear_force();
-      b.clear_force();
-      spread_forces(a, X, F, kernel);
-      fast.spread(b, F);
-      for (int d = 0; d < 3; ++d)
-        for (std::size_t node = 0; node < a.num_nodes(); ++node)
-          ASSERT_EQ(a.force_data(d)[node], b.force_data(d)[node]) << "node " << node;
+      // On one thread and on several, where each owns a range of nodes.
+      const int saved = omp_get_max_threads();
+      for (int threads : {1, 2, 3}) {
+        omp_set_num_threads(threads);
+        Lattice a = L, b = L;
+        a.clear_force();
+        b.clear_force();
+        spread_forces(a, X, F, kernel);
+        fast.spread(b, F);
+        for (int d = 0; d < 3; ++d)
+          for (std::size_t node = 0; node < a.num_nodes(); ++node)
+            ASSERT_EQ(a.force_data(d)[node], b.force_data(d)[node]) << "node " << node << ", " << threads << " threads";
+        b.clear_force();  // the field written directly is cleared whole
+        for (int d = 0; d < 3; ++d)
+          for (std::size_t node = 0; node < b.num_nodes(); ++node) ASSERT_EQ(b.force_data(d)[node], 0.0);
+      }
+      omp_set_num_threads(saved);
     }
     L.clear_force();
     spread_forces(L, X, Points::Constant(X.rows(), 3, 1e-4));

@@ -129,6 +129,24 @@ TEST(ContactSearch, VerletListEqualsTheSearchInEveryCall) {
   }
 }
 
+// A cell thrown far off along an axis without a period (a run blowing up) does not ask for bins
+// by the million (fifty million here before, and an overflowing bin index where two axes spread):
+// the search still finds every pair.
+TEST(ContactSearch, FarFlungVertexNeedsNoBinsBeyondMemory) {
+  const Vessel v = Vessel::channel(4.0, 3.0, 5.0);
+  std::vector<int> cell_of;
+  Points x = random_cloud(v, 5, 60, cell_of, 3);
+  x(0, 2) = 1e15;
+  const ContactLaw law{1.3, 0.45};
+  ContactSearch search;
+  Points F = Points::Zero(x.rows(), 3), Fref;
+  const double e = search.add_cell_contact(v, law, x, cell_of, F);
+  const double eref = reference_energy(v, law, x, cell_of, Fref);
+  ASSERT_GT(eref, 0);
+  EXPECT_NEAR(e, eref, 1e-12 * eref);
+  EXPECT_LT((F - Fref).cwiseAbs().maxCoeff(), 1e-12);
+}
+
 // A vertex's contact force is summed over its partners in row order: a far cell appended to the
 // rows (which moves the bins of the axes without a period) leaves every other force unchanged bit
 // for bit, and so does leaving out a cell that touches no other (rows keep their order). This is

@@ -159,6 +159,14 @@ class Lattice {
     note_forced(node);
   }
   void set_uniform_force(const Vec3& F);
+  /// The force field to add to directly, component d of node n at [d * slot_stride() + n], for
+  /// writers that cover most nodes from several threads (the immersed boundary's spreading); the
+  /// next clear_force then clears the whole field.
+  double* force_field_for_writing() {
+    force_everywhere_ = true;
+    forced_.clear();
+    return force_.data();
+  }
   Vec3 force(std::size_t node) const {
     const double* f = force_.data();
     return {f[node], f[stride_ + node], f[2 * stride_ + node]};
