@@ -51,7 +51,8 @@ int wrap(int i, int n) {
 }
 }  // namespace
 
-IbStencil ib_stencil(const std::array<int, 3>& n, bool walls, const Vec3& X, IbKernel kernel) {
+int ib_stencil_into(const std::array<int, 3>& n, bool walls, const Vec3& X, IbKernel kernel, std::size_t* node,
+                    double* weight) {
   if (!X.allFinite()) throw Error("IB node position is not finite");
   const int m = static_cast<int>(std::ceil(ib_kernel_half_width(kernel)));
   int idx[3][4];
@@ -73,19 +74,25 @@ IbStencil ib_stencil(const std::array<int, 3>& n, bool walls, const Vec3& X, IbK
       }
     }
   }
-  IbStencil st;
+  int size = 0;
   for (int c = 0; c < count; ++c) {
     for (int b = 0; b < count; ++b) {
       const double wbc = w[1][b] * w[2][c];
       for (int a = 0; a < count; ++a) {
-        st.node[st.size] = static_cast<std::size_t>(idx[0][a]) +
+        node[size] = static_cast<std::size_t>(idx[0][a]) +
                            static_cast<std::size_t>(n[0]) * (static_cast<std::size_t>(idx[1][b]) +
                                                              static_cast<std::size_t>(n[1]) * static_cast<std::size_t>(idx[2][c]));
-        st.weight[st.size] = w[0][a] * wbc;
-        ++st.size;
+        weight[size] = w[0][a] * wbc;
+        ++size;
       }
     }
   }
+  return size;
+}
+
+IbStencil ib_stencil(const std::array<int, 3>& n, bool walls, const Vec3& X, IbKernel kernel) {
+  IbStencil st;
+  st.size = ib_stencil_into(n, walls, X, kernel, st.node.data(), st.weight.data());
   return st;
 }
 
@@ -136,15 +143,15 @@ void IbInterpolator::prepare(const Lattice& lattice, const Points& X, IbKernel k
   lattice_nodes_ = lattice.num_nodes();
   node_.resize(static_cast<std::size_t>(nodes_) * per_node_);
   weight_.resize(node_.size());
+  const std::array<int, 3> n = {lattice.nx(), lattice.ny(), lattice.nz()};
+  const bool walls = lattice.config().walls;
   bool failed = false;
   std::string message;
 #pragma omp parallel for schedule(static) if (nodes_ >= 256)
   for (Eigen::Index k = 0; k < nodes_; ++k) {
     try {
-      const IbStencil st = ib_stencil(lattice, row(X, k), kernel);
       const std::size_t at = static_cast<std::size_t>(k) * per_node_;
-      std::copy_n(st.node.begin(), per_node_, node_.begin() + static_cast<std::ptrdiff_t>(at));
-      std::copy_n(st.weight.begin(), per_node_, weight_.begin() + static_cast<std::ptrdiff_t>(at));
+      ib_stencil_into(n, walls, row(X, k), kernel, node_.data() + at, weight_.data() + at);
     } catch (const Error& e) {
 #pragma omp critical
       {

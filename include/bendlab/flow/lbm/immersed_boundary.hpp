@@ -46,6 +46,10 @@ IbStencil ib_stencil(const Lattice& lattice, const Vec3& X, IbKernel kernel);
 /// The same for an n[0] x n[1] x n[2] lattice (with or without walls) that need not exist: node
 /// indices i + n0 (j + n1 k), as Lattice::index (a subdomain maps them to its own nodes).
 IbStencil ib_stencil(const std::array<int, 3>& n, bool walls, const Vec3& X, IbKernel kernel);
+/// The same written to node[0 .. size) and weight[0 .. size), returning size ((2 ceil(half
+/// width))^3): no stencil object to fill and copy for each position.
+int ib_stencil_into(const std::array<int, 3>& n, bool walls, const Vec3& X, IbKernel kernel, std::size_t* node,
+                    double* weight);
 
 /// Adds sum_k F_k Phi(x - X_k) to the lattice force field (X, F: N x 3).
 void spread_forces(Lattice& lattice, const Points& X, const Points& F, IbKernel kernel = IbKernel::Phi2);
