@@ -72,6 +72,10 @@ def main():
     p.add_argument("--json", nargs="*", default=None, help="earlier reports instead of running")
     p.add_argument("--before", default=None, help="an older bench_suspension to set against this one")
     p.add_argument("--before-json", nargs="*", default=None, help="earlier reports of the older build")
+    p.add_argument("--before-label", default="the build given as --before",
+                   help="what the older build is (its commit), for the document")
+    p.add_argument("--save-json", default=None,
+                   help="a folder to keep this run's reports in (after.N.json, before.N.json) for --json")
     p.add_argument("--out", default="docs/results/suspension_performance.md")
     a = p.parse_args()
     before_reports = []
@@ -101,6 +105,12 @@ def main():
             with open(path) as f:
                 before_reports.append(json.load(f))
     load_end = load_average()
+    if a.save_json:
+        os.makedirs(a.save_json, exist_ok=True)
+        for name, group in (("after", reports), ("before", before_reports)):
+            for k, r in enumerate(group):
+                with open(os.path.join(a.save_json, f"{name}.{k + 1}.json"), "w") as f:
+                    json.dump(r, f)
     m = medians(reports)
     def ms(row):  # every benchmark of bench_suspension reports milliseconds
         return row["real_time"]
@@ -144,7 +154,7 @@ def main():
           "CPU cost of a whole step over that of the fluid step alone on the same lattice (real time, one "
           "process), on the pipeflow case above and on the tube study's reference case (D = 10 um, 20 um periodic, "
           "tau = 1.82, 5 red blood cells of 1280 triangles, time scale 10: 40 x 24 x 24 nodes). "
-          + ("Before: the build given as --before, run alternately with this one in the same run. "
+          + (f"Before: {a.before_label}, run alternately with this one in the same run. "
              if before_reports else "No earlier build was measured in this run. ")
           + "Targets: the pipeflow step at most 4.2 fluid steps on one thread; two threads at least 1.7 times "
             "one.", "",
@@ -180,7 +190,10 @@ def main():
               f"against {POSITIONS_AND_FORCES:.0f} bytes per vertex for positions and forces alone: what a cell adds "
               "is per-vertex arrays only (positions, forces, velocities, its immersed-boundary stencils and its "
               "contact-search entries), no copy of its kind's topology, reference shape or bending caches, which "
-              "every cell of a kind shares.", ""]
+              "every cell of a kind shares. The contact search's Verlet list holds 4 bytes per partner within the "
+              "cutoff plus its skin, and the cells added here lie on top of the first (each a whole period away, so "
+              "that the run stays finite): every vertex has the partners of 20 coinciding membranes, the list's "
+              "worst case; cells that only touch give each vertex a few.", ""]
     else:
         L += ["not measured", ""]
     L += ["Where a target is not met, the reason is in docs/design.md (\"Many cells: where the time goes\").", ""]

@@ -234,18 +234,21 @@ bool ContactSearch::list_is_current(const Vessel& vessel, const ContactLaw& law,
 
 void ContactSearch::build_list(const Vessel& vessel, const ContactLaw& law, const Points& x, const std::vector<int>& cell_of) {
   ++list_builds_;
-  found_.clear();
-  for_each_pair<true>(vessel, x, cell_of, (1.0 + kSkinFraction) * law.cutoff,
-                      [&](int i, int j, const Vec3&, double) { found_.emplace_back(i, j); }, [](int) {});
-  std::sort(found_.begin(), found_.end());
+  // Two passes of the search, counting each row's partners and then filling them in, so that the
+  // list is the only store of pairs (4 bytes each); each row's partners sorted afterwards.
   const Eigen::Index n = x.rows();
+  const double range = (1.0 + kSkinFraction) * law.cutoff;
   list_start_.assign(static_cast<std::size_t>(n) + 1, 0);
-  list_row_.resize(found_.size());
-  for (std::size_t k = 0; k < found_.size(); ++k) {
-    ++list_start_[static_cast<std::size_t>(found_[k].first) + 1];
-    list_row_[k] = found_[k].second;
-  }
+  for_each_pair<true>(vessel, x, cell_of, range,
+                      [&](int i, int, const Vec3&, double) { ++list_start_[static_cast<std::size_t>(i) + 1]; }, [](int) {});
   for (Eigen::Index i = 0; i < n; ++i) list_start_[static_cast<std::size_t>(i) + 1] += list_start_[static_cast<std::size_t>(i)];
+  list_row_.resize(static_cast<std::size_t>(list_start_.back()));
+  fill_.assign(list_start_.begin(), list_start_.end() - 1);
+  for_each_pair<true>(vessel, x, cell_of, range,
+                      [&](int i, int j, const Vec3&, double) { list_row_[static_cast<std::size_t>(fill_[static_cast<std::size_t>(i)]++)] = j; },
+                      [](int) {});
+  for (Eigen::Index i = 0; i < n; ++i)
+    std::sort(list_row_.begin() + list_start_[static_cast<std::size_t>(i)], list_row_.begin() + list_start_[static_cast<std::size_t>(i) + 1]);
   list_x_ = x;
   list_cell_ = cell_of;
   list_cutoff_ = law.cutoff;

@@ -93,7 +93,7 @@ class ContactSearch {
   bool list_is_current(const Vessel& vessel, const ContactLaw& law, const Points& x, const std::vector<int>& cell_of) const;
   void build_list(const Vessel& vessel, const ContactLaw& law, const Points& x, const std::vector<int>& cell_of);
   std::vector<int> list_start_, list_row_, list_cell_;
-  std::vector<std::pair<int, int>> found_;  // (i, j) while building
+  std::vector<int> fill_;  // each row's next free place while building
   Points list_x_;
   double list_cutoff_ = 0;
   Vec3 list_period_ = Vec3::Zero();
