@@ -44,15 +44,11 @@ class HeldRun(study_runner.StudyRun):
         return f"D10_H0.3_C_mt11280_S{fmt_g(TIME_SCALE)}_N{self.every}"
 
     def arguments(self, out):
-        return ["flow", "--geometry", "tube", "--diameter", "10", "--length", "20", "--dx", "0.5", "--tau", "1.82",
-                "--pseudo-shear-rate", "100", "--hematocrit", "0.3", "--seed", "1", "--method", "C",
-                "--bending-net-force", "keep", "--mesh", "mt1:1280", "--time-scale", fmt_g(TIME_SCALE),
-                "--membrane-every", str(self.every), "--t-end", fmt_g(self.t_end), "--sample-every", "0.0001",
-                "--snapshot-every", "0.01", "--out", str(out)]
+        return study_runner.tube_reference_arguments(
+            ["--time-scale", fmt_g(TIME_SCALE), "--membrane-every", str(self.every)], self.t_end, out)
 
     def key(self):
-        return {"t_end": self.t_end, "diameter_um": 10.0, "hematocrit": 0.3, "method": "C", "mesh": "mt1:1280",
-                "tau": 1.82, "dx_um": 0.5, "pseudo_shear_rate": 100.0, "seed": 1, "time_scale": TIME_SCALE,
+        return {"t_end": self.t_end, **study_runner.TUBE_REFERENCE_KEY, "time_scale": TIME_SCALE,
                 "membrane_every": self.every}
 
     def assumed(self):
@@ -61,13 +57,6 @@ class HeldRun(study_runner.StudyRun):
 
     def label(self):
         return f"D = 10 um, H_T 0.3, Method C, time scale {fmt_g(TIME_SCALE)}, membrane forces every {self.every}"
-
-
-def within(a, b):
-    """(difference in combined standard errors, the difference) of two summary entries."""
-    d = a["mean"] - b["mean"]
-    se = math.hypot(a["standard_error"], b["standard_error"])
-    return (d / se if se > 0 else math.inf), d
 
 
 def main(argv):
@@ -124,7 +113,7 @@ def main(argv):
             m = s[key]
             text = f"{m['mean']:.4g} ± {m['standard_error']:.2g}"
             if r.every != 1 and reference is not None:
-                z, _ = within(m, reference[key])
+                z, _ = study_runner.standard_errors_apart(m, reference[key])
                 text += f" ({z:+.1f})"
             cells.append(text)
         steps = round(s["t_end"] / s["dt_s"])
@@ -133,7 +122,7 @@ def main(argv):
         L.append(f"| {r.every} | {steps} | {wall_text} | " + " | ".join(cells) + " |")
     if reference is not None:
         outside = [r.every for r in runs if r.every != 1 and summaries[r.every] is not None
-                   and any(abs(within(summaries[r.every][k], reference[k])[0]) > 2 for k, _ in MEASURES)]
+                   and any(abs(study_runner.standard_errors_apart(summaries[r.every][k], reference[k])[0]) > 2 for k, _ in MEASURES)]
         inside = [r.every for r in runs if r.every != 1 and summaries[r.every] is not None and r.every not in outside]
         L += ["", "Within 2 standard errors of N = 1 on all three measures: "
               + (", ".join(f"N = {n}" for n in inside) if inside else "none")

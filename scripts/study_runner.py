@@ -48,6 +48,28 @@ def fmt_g(x):
     return f"{x:g}"
 
 
+def standard_errors_apart(a, b):
+    """(difference of two summary entries in their combined standard errors, the difference)."""
+    d = a["mean"] - b["mean"]
+    se = math.hypot(a["standard_error"], b["standard_error"])
+    return (d / se if se > 0 else math.inf), d
+
+
+# The tube study's reference case (scripts/tube_study.py: D = 10 um, 20 um periodic, dx = 0.5 um,
+# tau = 1.82, pseudo-shear rate 100 1/s, H_T 0.3, seed 1, Method C with its net force kept,
+# mt1:1280), which the time-scaling and membrane-every studies vary.
+TUBE_REFERENCE_KEY = {"diameter_um": 10.0, "hematocrit": 0.3, "method": "C", "mesh": "mt1:1280", "tau": 1.82,
+                      "dx_um": 0.5, "pseudo_shear_rate": 100.0, "seed": 1}
+
+
+def tube_reference_arguments(extra, t_end, out):
+    """`bendlab flow`'s arguments for the reference case with `extra` options, to t_end, into out."""
+    return (["flow", "--geometry", "tube", "--diameter", "10", "--length", "20", "--dx", "0.5", "--tau", "1.82",
+             "--pseudo-shear-rate", "100", "--hematocrit", "0.3", "--seed", "1", "--method", "C",
+             "--bending-net-force", "keep", "--mesh", "mt1:1280"] + list(extra)
+            + ["--t-end", fmt_g(t_end), "--sample-every", "0.0001", "--snapshot-every", "0.01", "--out", str(out)])
+
+
 def close(a, b):
     """Whether two numbers agree to 1e-12 (relative, absolute below 1); False where one is None."""
     return a is not None and b is not None and abs(float(a) - float(b)) <= 1e-12 * max(1.0, abs(float(b)))

@@ -46,26 +46,14 @@ class ScaledRun(study_runner.StudyRun):
         return f"D10_H0.3_C_mt11280_S{fmt_g(self.scale)}"
 
     def arguments(self, out):
-        return ["flow", "--geometry", "tube", "--diameter", "10", "--length", "20", "--dx", "0.5", "--tau", "1.82",
-                "--pseudo-shear-rate", "100", "--hematocrit", "0.3", "--seed", "1", "--method", "C",
-                "--bending-net-force", "keep", "--mesh", "mt1:1280", "--plasma-density", fmt_g(DENSITY * self.scale),
-                "--t-end", fmt_g(self.t_end), "--sample-every", "0.0001", "--snapshot-every", "0.01",
-                "--out", str(out)]
+        return study_runner.tube_reference_arguments(["--plasma-density", fmt_g(DENSITY * self.scale)], self.t_end,
+                                                     out)
 
     def key(self):
-        return {"t_end": self.t_end, "diameter_um": 10.0, "hematocrit": 0.3, "method": "C", "mesh": "mt1:1280",
-                "tau": 1.82, "dx_um": 0.5, "pseudo_shear_rate": 100.0, "seed": 1,
-                "plasma_density": DENSITY * self.scale}
+        return {"t_end": self.t_end, **study_runner.TUBE_REFERENCE_KEY, "plasma_density": DENSITY * self.scale}
 
     def label(self):
         return f"D = 10 um, H_T 0.3, Method C, density x {fmt_g(self.scale)}"
-
-
-def within(a, b):
-    """(difference in combined standard errors, the difference) of two summary entries."""
-    d = a["mean"] - b["mean"]
-    se = math.hypot(a["standard_error"], b["standard_error"])
-    return (d / se if se > 0 else math.inf), d
 
 
 def main(argv):
@@ -110,7 +98,7 @@ def main(argv):
             m = s[key]
             text = f"{m['mean']:.4g} ± {m['standard_error']:.2g}"
             if ref is not None:
-                z, _ = within(m, ref[key])
+                z, _ = study_runner.standard_errors_apart(m, ref[key])
                 text += f" ({z:+.1f})"
             cells.append(text)
         steps = round(s["t_end"] / s["dt_s"])
@@ -126,7 +114,7 @@ def main(argv):
             L.append(f"| {fmt_g(r.scale)} | not run yet | | | " + " | " * (len(MEASURES) - 1) + " |")
             continue
         L.append(row(fmt_g(r.scale), s, reference))
-        ok = all(abs(within(s[key], reference[key])[0]) <= 2 for key, _ in MEASURES)
+        ok = all(abs(study_runner.standard_errors_apart(s[key], reference[key])[0]) <= 2 for key, _ in MEASURES)
         if ok and failed_at is None:
             largest_ok = max(largest_ok, r.scale)
         elif not ok and failed_at is None:
