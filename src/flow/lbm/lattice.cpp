@@ -265,7 +265,10 @@ struct Trt {
   LBM_INLINE void operator()(double* f, double Fx, double Fy, double Fz) const { apply(f, Fx, Fy, Fz, Pairs{}); }
 };
 
-constexpr std::size_t kParallelNodes = std::size_t{1} << 15;
+// A step of this many nodes takes some 50 us on one core, ten times what opening a parallel region
+// costs; smaller lattices (tests) step on one thread. (The 10 um tube, 23040 nodes, was serial at
+// the former 2^15.)
+constexpr std::size_t kParallelNodes = std::size_t{1} << 12;
 
 struct StepArgs {
   double* f;
