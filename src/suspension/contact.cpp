@@ -24,6 +24,14 @@ double ContactLaw::energy(double r) const {
   return r >= 0 ? max_force * cutoff / 3.0 * s * s * s : max_force * cutoff / 3.0 - max_force * r;
 }
 
+namespace {
+// Coordinate a of x into [-P/2, P/2) along a periodic axis of period P (unchanged along others):
+// the one wrapping of the bins and of the Verlet list's separations, so that they agree bit for bit.
+double wrapped_coordinate(const Vessel& vessel, const Vec3& period, double c, int a) {
+  return vessel.periodic(a) ? c - period[a] * std::floor((c + 0.5 * period[a]) / period[a]) : c;
+}
+}  // namespace
+
 double add_wall_contact(const Vessel& vessel, const ContactLaw& law, const Points& x, Points& F) {
   double energy = 0;
   for (Eigen::Index i = 0; i < x.rows(); ++i) {
@@ -72,8 +80,7 @@ void ContactSearch::bin(const Vessel& vessel, const Points& x, const std::vector
   for (Eigen::Index i = 0; i < n; ++i) {
     int b[3];
     for (int a = 0; a < 3; ++a) {
-      double c = x(i, a);
-      if (vessel.periodic(a)) c -= period[a] * std::floor((c - lo_[a]) / period[a]);  // into [lo, lo + period)
+      const double c = wrapped_coordinate(vessel, period, x(i, a), a);  // into [lo, lo + period)
       wrapped_(i, a) = c;
       const double at = std::floor((c - lo_[a]) / w_[a]);  // clamped before the cast: NaN goes to 0
       b[a] = at > 0 ? static_cast<int>(std::min(at, static_cast<double>(nb_[a] - 1))) : 0;
@@ -272,11 +279,7 @@ double ContactSearch::add_cell_contact(const Vessel& vessel, const ContactLaw& l
   const Eigen::Index n = x.rows();
   wrapped_.resize(n, 3);
   for (Eigen::Index i = 0; i < n; ++i)
-    for (int a = 0; a < 3; ++a) {
-      double c = x(i, a);
-      if (vessel.periodic(a)) c -= period[a] * std::floor((c + 0.5 * period[a]) / period[a]);  // as bin()
-      wrapped_(i, a) = c;
-    }
+    for (int a = 0; a < 3; ++a) wrapped_(i, a) = wrapped_coordinate(vessel, period, x(i, a), a);
   const double r2max = law.cutoff * law.cutoff;
   double energy = 0;
   for (Eigen::Index i = 0; i < n; ++i) {
