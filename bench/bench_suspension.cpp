@@ -10,6 +10,9 @@
 // 5). Benchmarks (argument: OpenMP threads):
 //   BM_PipeflowStep      one whole step: steps_per_second is the figure to set against HemoCell's
 //                        26 (1 rank) and 48 (2 ranks) steps/s on this kind of machine;
+//   BM_PipeflowStepEvery20  the same with membrane forces every 20 steps (flow --membrane-every
+//                        20), HemoCell's default stepMaterialEvery: its figure to set against
+//                        HemoCell's default updates (scripts/hemocell_like_for_like.py);
 //   BM_PipeflowFluid     the fluid step alone (the same lattice, no cells): cells_fraction of the
 //                        whole step = 1 - fluid / step, computed by scripts from the two.
 //   BM_Tube10Step        the tube study's reference case at time scale 10 (D = 10 um, 5 red blood
@@ -45,8 +48,10 @@ double heap_in_use() {
   return static_cast<double>(m.uordblks) + static_cast<double>(m.hblkhd);
 }
 
-std::unique_ptr<LbmSuspension> pipeflow(bool with_cells, double hematocrit = 0) {
-  auto s = std::make_unique<LbmSuspension>(bench::pipeflow_options());
+std::unique_ptr<LbmSuspension> pipeflow(bool with_cells, double hematocrit = 0, int membrane_every = 1) {
+  SuspensionOptions o = bench::pipeflow_options();
+  o.membrane_every = membrane_every;
+  auto s = std::make_unique<LbmSuspension>(o);
   if (with_cells) bench::add_pipeflow_cells(*s, hematocrit, [&] { return s->positions(); });
   return s;
 }
@@ -55,6 +60,18 @@ void BM_PipeflowStep(benchmark::State& state) {
   omp_set_num_threads(static_cast<int>(state.range(0)));
   static std::unique_ptr<LbmSuspension> s = pipeflow(true);
   s->run(2);
+  for (auto _ : state) s->step();
+  state.counters["steps_per_second"] = benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["cells"] = s->num_cells();
+  state.counters["vertices"] = static_cast<double>(s->positions().rows());
+}
+
+// HemoCell's default time-scale separation for the membrane: forces every 20 steps (flow
+// --membrane-every 20), everything else every step.
+void BM_PipeflowStepEvery20(benchmark::State& state) {
+  omp_set_num_threads(static_cast<int>(state.range(0)));
+  static std::unique_ptr<LbmSuspension> s = pipeflow(true, 0, 20);
+  s->run(20);
   for (auto _ : state) s->step();
   state.counters["steps_per_second"] = benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
   state.counters["cells"] = s->num_cells();
@@ -145,6 +162,7 @@ void BM_ExtraCellMemory(benchmark::State& state) {
 
 BENCHMARK(BM_PipeflowFluid)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_PipeflowStep)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_PipeflowStepEvery20)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Tube10Fluid)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Tube10Step)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_PipeflowHt03Step)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);

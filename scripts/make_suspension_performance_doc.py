@@ -22,7 +22,8 @@ and 6 small stiff cells, every force updated every step):
     bench_suspension, run alternately with this one in the same run) the same before, with the
     ratios: targets at most 4.2 fluid steps on the pipeflow case and 1.7 times the one-thread step
     on two threads;
-  - docs/results/membrane_every.md (scripts/membrane_every_study.py), included as it stands.
+  - docs/results/hemocell_like_for_like.md (scripts/hemocell_like_for_like.py, which needs a HemoCell
+    build) and docs/results/membrane_every.md (scripts/membrane_every_study.py), included as they stand.
 Every figure is the median over the runs; the load average before and after is recorded. The
 timings are only as quiet as the machine. Standard library only.
 """
@@ -197,11 +198,12 @@ def main():
     else:
         L += ["not measured", ""]
     L += ["Where a target is not met, the reason is in docs/design.md (\"Many cells: where the time goes\").", ""]
-    held = os.path.join(os.path.dirname(a.out) or ".", "membrane_every.md")
-    if os.path.exists(held):
-        with open(held) as f:
-            lines = f.read().splitlines()
-        L += ["## " + lines[0].lstrip("# ") + " (docs/results/membrane_every.md, included)", ""] + lines[1:]
+    for name in ("hemocell_like_for_like.md", "membrane_every.md"):
+        held = os.path.join(os.path.dirname(a.out) or ".", name)
+        if os.path.exists(held):
+            with open(held) as f:
+                lines = f.read().splitlines()
+            L += ["## " + lines[0].lstrip("# ") + f" (docs/results/{name}, included)", ""] + lines[1:]
     os.makedirs(os.path.dirname(a.out) or ".", exist_ok=True)
     tmp = a.out + ".tmp"
     with open(tmp, "w") as f:
