@@ -309,6 +309,94 @@ TEST(Lattice, VelocitiesOfARunEqualVelocityAtEveryNode) {
   }
 }
 
+// A writer that declares its runs (the immersed boundary's spreading) leaves a field that
+// clear_force clears entirely: runs alone, runs beside add_force, and runs that cover more than
+// half of the field (then swept whole).
+TEST(Lattice, ClearForceClearsTheRunsWrittenThrough) {
+  Lattice L(box(10, 6, 5, 1.0, false));
+  const std::size_t n = L.num_nodes(), S = L.slot_stride();
+  auto all_zero = [&] {
+    for (int d = 0; d < 3; ++d)
+      for (std::size_t node = 0; node < n; ++node)
+        if (L.force_data(d)[node] != 0.0) return false;
+    return true;
+  };
+  for (const std::size_t rows : {std::size_t{3}, std::size_t{25}}) {  // 30 and 250 of 300 nodes
+    std::vector<Lattice::NodeRun> runs;
+    for (std::size_t r = 0; r < rows; ++r) runs.push_back({10 * r + 2, 7});
+    double* f = L.force_field_for_writing(runs);
+    for (const Lattice::NodeRun& run : runs)
+      for (int t = 0; t < run.count; ++t)
+        for (int d = 0; d < 3; ++d) f[d * S + run.first + static_cast<std::size_t>(t)] = 1.0 + d;
+    L.add_force(n - 1, Vec3(1, 2, 3));
+    EXPECT_FALSE(all_zero());
+    L.clear_force();
+    EXPECT_TRUE(all_zero()) << rows << " rows written";
+  }
+}
+
+// step_gathering against step() then velocities_of_run, bit for bit: the same populations, and the
+// same velocities for the runs the step gathered and for those it left (rows beside a wall link,
+// rows whose neighbours another thread steps), at both parities, on 1, 2 and 3 threads, on lattices
+// large enough to step on all of them: a periodic box (rows that wrap in y and z), moving walls,
+// a tube's section and a slit's.
+TEST(Lattice, StepGatheringEqualsTheStepThenTheGather) {
+  std::vector<LatticeConfig> configs;
+  configs.push_back(box(16, 16, 17, 0.9, false));
+  configs.push_back(box(16, 17, 16, 1.0, true, 0.02));
+  LatticeConfig tube = box(16, 20, 20, 1.2, false);
+  tube.collision = Collision::TRT;
+  tube.section = std::make_shared<TubeWall>(8.3);
+  configs.push_back(tube);
+  LatticeConfig slit = box(16, 18, 16, 0.8, false);
+  slit.collision = Collision::TRT;
+  slit.section = std::make_shared<SlabWall>(6.0);
+  configs.push_back(slit);
+  const int threads_before = omp_get_max_threads();
+  for (const LatticeConfig& c : configs) {
+    for (int threads = 1; threads <= 3; ++threads) {
+      omp_set_num_threads(threads);
+      Lattice A(c), B(c);
+      for (Lattice* L : {&A, &B}) {
+        L->initialise([](const Vec3& x) { return Vec3(0.01 * std::cos(x.z()), 0.003 * std::sin(x.x()), 0.002 * x.y()); });
+        L->set_uniform_force(Vec3(1e-5, -2e-5, 3e-6));
+        L->add_force(1, Vec3(2e-4, 1e-4, -3e-4));
+      }
+      ASSERT_GE(A.num_nodes(), std::size_t{4096}) << "the lattice must step on every thread";
+      const int nx = A.nx();
+      // Two runs per row, ascending: the row's first three nodes and its last nx - 5.
+      std::vector<Lattice::NodeRun> runs;
+      for (std::size_t row = 0; row < A.num_nodes() / static_cast<std::size_t>(nx); ++row) {
+        runs.push_back({row * static_cast<std::size_t>(nx), 3});
+        runs.push_back({row * static_cast<std::size_t>(nx) + 5, nx - 5});
+      }
+      std::size_t gathered = 0, left = 0;
+      for (int step = 0; step < 4; ++step) {
+        std::vector<double> u(3 * A.num_nodes(), std::numeric_limits<double>::quiet_NaN());
+        std::vector<std::uint8_t> done;
+        A.step_gathering(runs, u.data(), done);
+        B.step();
+        ASSERT_EQ(A.raw_populations(), B.raw_populations()) << "step " << step << ", " << threads << " threads";
+        ASSERT_EQ(done.size(), runs.size());
+        for (std::size_t k = 0; k < runs.size(); ++k) {
+          std::vector<double> want(3 * static_cast<std::size_t>(runs[k].count)), left_for_later(want.size());
+          B.velocities_of_run(runs[k].first, runs[k].count, want.data());
+          A.velocities_of_run(runs[k].first, runs[k].count, left_for_later.data());
+          const double* got = done[k] ? u.data() + 3 * runs[k].first : left_for_later.data();
+          (done[k] ? gathered : left) += 1;
+          for (std::size_t i = 0; i < want.size(); ++i)
+            ASSERT_EQ(got[i], want[i]) << "step " << step << ", " << threads << " threads, run " << k << (done[k] ? " gathered" : " left") << " i " << i;
+        }
+      }
+      EXPECT_GT(gathered, 0u) << "the step gathered no run";
+      if (c.section != nullptr || threads > 1) {
+        EXPECT_GT(left, 0u) << "the step left no run (wall links, thread borders)";
+      }
+    }
+  }
+  omp_set_num_threads(threads_before);
+}
+
 // The row table of populations() against the coordinates of populations_reference(), every node
 // at both parities, on every kind of lattice: fully periodic, moving walls, a tube's section and a
 // slit's, with a flow and a force so that no population is trivially equal to another.

@@ -164,6 +164,7 @@ void IbInterpolator::prepare(const Lattice& lattice, const Points& X, IbKernel k
     nodes_ = 0;
     throw Error(message);
   }
+  plan_runs(lattice);
 }
 
 void IbInterpolator::spread(Lattice& lattice, const Points& F) const {
@@ -172,10 +173,11 @@ void IbInterpolator::spread(Lattice& lattice, const Points& F) const {
   // Many stencils on several threads: each thread owns a range of lattice nodes and adds, from every
   // stencil in vertex order, the entries that fall in its range. Each node then sums its entries in
   // the serial order below, bit for bit, whatever the thread count.
+  // The field is written directly; the lattice's next clear_force clears the touched runs only.
+  double* f = lattice.force_field_for_writing(runs_);
+  const std::size_t stride = lattice.slot_stride();
   const std::size_t entries = static_cast<std::size_t>(nodes_) * static_cast<std::size_t>(per_node_);
   if (omp_get_max_threads() > 1 && entries >= lattice_nodes_ / 8) {
-    double* f = lattice.force_field_for_writing();
-    const std::size_t stride = lattice.slot_stride();
 #pragma omp parallel
     {
       const auto t = static_cast<std::size_t>(omp_get_thread_num()), T = static_cast<std::size_t>(omp_get_num_threads());
@@ -200,14 +202,18 @@ void IbInterpolator::spread(Lattice& lattice, const Points& F) const {
     const std::size_t at = static_cast<std::size_t>(k) * per_node_;
     for (int s = 0; s < per_node_; ++s) {
       const double w = weight_[at + s];
-      if (w != 0.0) lattice.add_force(node_[at + s], w * Fk);
+      if (w == 0.0) continue;
+      const std::size_t node = node_[at + s];
+      const Vec3 wF = w * Fk;  // Lattice::add_force's arithmetic
+      f[node] += wF.x();
+      f[stride + node] += wF.y();
+      f[2 * stride + node] += wF.z();
     }
   }
 }
 
-void IbInterpolator::interpolate(const Lattice& lattice, Points& U) {
+void IbInterpolator::plan_runs(const Lattice& lattice) {
   const std::size_t n = lattice.num_nodes();
-  if (n != lattice_nodes_) throw Error("IB interpolation: the stencils were prepared on another lattice");
   // The nodes in some stencil, ascending.
   marks_.assign((n + 63) / 64, 0);
   for (std::size_t e = 0; e < node_.size(); ++e)
@@ -216,9 +222,6 @@ void IbInterpolator::interpolate(const Lattice& lattice, Points& U) {
   for (std::size_t w = 0; w < marks_.size(); ++w)
     for (std::uint64_t bits = marks_[w]; bits != 0; bits &= bits - 1)
       touched_.push_back(64 * w + static_cast<std::size_t>(__builtin_ctzll(bits)));
-  // Their velocities, a run of consecutive touched nodes of one x-row at a time
-  // (Lattice::velocities_of_run: velocity() bit for bit, the run's slots read together), then
-  // each node's stencil sum.
   if (velocity_.size() != 3 * n) velocity_.assign(3 * n, 0.0);
   const std::size_t nx = static_cast<std::size_t>(lattice.nx());
   runs_.clear();
@@ -229,12 +232,22 @@ void IbInterpolator::interpolate(const Lattice& lattice, Points& U) {
     runs_.push_back({first, static_cast<int>(end - t)});
     t = end;
   }
+}
+
+void IbInterpolator::gather_runs(const Lattice& lattice) {
+  // Their velocities, a run of consecutive touched nodes of one x-row at a time
+  // (Lattice::velocities_of_run: velocity() bit for bit, the run's slots read together).
   const auto runs = static_cast<std::ptrdiff_t>(runs_.size());
+  const bool all = gathered_.empty();
 #pragma omp parallel for schedule(static) if (touched_.size() >= 4096)
   for (std::ptrdiff_t r = 0; r < runs; ++r) {
-    const Run& run = runs_[static_cast<std::size_t>(r)];
+    if (!all && gathered_[static_cast<std::size_t>(r)]) continue;
+    const Lattice::NodeRun& run = runs_[static_cast<std::size_t>(r)];
     lattice.velocities_of_run(run.first, run.count, velocity_.data() + 3 * run.first);
   }
+}
+
+void IbInterpolator::sum_stencils(Points& U) const {
   U.resize(nodes_, 3);
 #pragma omp parallel for schedule(static) if (nodes_ >= 1024)
   for (Eigen::Index k = 0; k < nodes_; ++k) {
@@ -248,6 +261,20 @@ void IbInterpolator::interpolate(const Lattice& lattice, Points& U) {
     }
     U.row(k) = u.transpose();
   }
+}
+
+void IbInterpolator::interpolate(const Lattice& lattice, Points& U) {
+  if (lattice.num_nodes() != lattice_nodes_) throw Error("IB interpolation: the stencils were prepared on another lattice");
+  gathered_.clear();
+  gather_runs(lattice);
+  sum_stencils(U);
+}
+
+void IbInterpolator::step_and_interpolate(Lattice& lattice, Points& U) {
+  if (lattice.num_nodes() != lattice_nodes_) throw Error("IB interpolation: the stencils were prepared on another lattice");
+  lattice.step_gathering(runs_, velocity_.data(), gathered_);
+  gather_runs(lattice);
+  sum_stencils(U);
 }
 
 void IbInterpolator::interpolate(const Lattice& lattice, const Points& X, Points& U, IbKernel kernel) {

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <utility>
 
 namespace bendlab::lbm {
@@ -496,6 +497,7 @@ Lattice::Lattice(const LatticeConfig& config) : config_(config) {
   fluid_nodes_ = n_;
   build_section();
   build_pull_rows();
+  build_gather_rows();
   // A multiple of 4 KiB (512 doubles) plus 9 cache lines: the slots' starts fall on 19 (and the
   // force components' on 3) different cache-line offsets modulo 4 KiB and modulo any larger power
   // of two up to 9 * 64 lines, so a row's streams neither alias nor share cache sets.
@@ -568,6 +570,34 @@ void Lattice::build_pull_rows() {
         const int js = wrap(j - kCy[q], ny), kw = wrap(ks, nz);
         r = solid_row(js, kw) ? kPullSolid : static_cast<std::int32_t>(js + ny * kw);
       }
+}
+
+void Lattice::build_gather_rows() {
+  const std::size_t rows = static_cast<std::size_t>(config_.ny) * static_cast<std::size_t>(config_.nz);
+  gather_lo_.resize(rows);
+  gather_hi_.resize(rows);
+  for (std::size_t r = 0; r < rows; ++r) {
+    std::int32_t lo = static_cast<std::int32_t>(r), hi = lo;
+    for (int q = 0; q < kQ; ++q) {
+      const std::int32_t s = pull_rows_[r * kQ + q];
+      if (s < 0) continue;  // a wall or solid: nothing another row writes
+      lo = std::min(lo, s);
+      hi = std::max(hi, s);
+    }
+    gather_lo_[r] = lo;
+    gather_hi_[r] = hi;
+  }
+  // The wall pass writes slots of the rows of its links: every row that reads one waits for it.
+  // (A row's readers are its source rows' readers' mirror: the 19 directions come in pairs.)
+  const int ny = config_.ny;
+  for (const WallLink& l : wall_links_) {
+    const std::size_t w = static_cast<std::size_t>(l.j) + static_cast<std::size_t>(ny) * static_cast<std::size_t>(l.k);
+    gather_hi_[w] = std::numeric_limits<std::int32_t>::max();
+    for (int q = 0; q < kQ; ++q) {
+      const std::int32_t s = pull_rows_[w * kQ + q];
+      if (s >= 0) gather_hi_[static_cast<std::size_t>(s)] = std::numeric_limits<std::int32_t>::max();
+    }
+  }
 }
 
 bool Lattice::is_solid(std::size_t node) const {
@@ -752,19 +782,36 @@ void Lattice::clear_force() {
   } else {
     double* f = force_.data();
     for (const std::size_t node : forced_) f[node] = f[stride_ + node] = f[2 * stride_ + node] = 0.0;
+    for (const NodeRun& run : forced_runs_)
+      for (int d = 0; d < 3; ++d) std::fill_n(f + d * stride_ + run.first, run.count, 0.0);
   }
   forced_.clear();
+  forced_runs_.clear();
+  forced_run_nodes_ = 0;
   force_everywhere_ = false;
+}
+
+double* Lattice::force_field_for_writing(const std::vector<NodeRun>& within) {
+  if (!force_everywhere_) {
+    for (const NodeRun& run : within) forced_run_nodes_ += static_cast<std::size_t>(run.count);
+    if (forced_run_nodes_ > n_ / 2) {
+      return force_field_for_writing();  // a sweep of the whole field is then the cheaper clear
+    }
+    forced_runs_.insert(forced_runs_.end(), within.begin(), within.end());
+  }
+  return force_.data();
 }
 
 void Lattice::set_uniform_force(const Vec3& F) {
   for (int d = 0; d < 3; ++d) std::fill_n(force_.begin() + d * stride_, n_, F[d]);
   forced_.clear();
+  forced_runs_.clear();
+  forced_run_nodes_ = 0;
   force_everywhere_ = true;
 }
 
 template <class Coll>
-void Lattice::step_with(const Coll& coll, int j0, int j1) {
+void Lattice::step_with(const Coll& coll, int j0, int j1, const Gather* gather) {
   StepArgs a{f_.data(), stride_, config_.nx, config_.ny, config_.nz, j0, j1 - j0, config_.walls, step_ % 2 == 1,
              config_.wall_velocity, {force_.data(), force_.data() + stride_, force_.data() + 2 * stride_},
              solid_rows_.empty() ? nullptr : solid_rows_.data(),
@@ -776,12 +823,56 @@ void Lattice::step_with(const Coll& coll, int j0, int j1) {
     const int t = omp_get_thread_num(), nt = omp_get_num_threads();
     const int r0 = static_cast<int>(static_cast<std::int64_t>(rows) * t / nt);
     const int r1 = static_cast<int>(static_cast<std::int64_t>(rows) * (t + 1) / nt);
-    process_rows(a, r0, r1, coll);
+    if (gather == nullptr) {
+      process_rows(a, r0, r1, coll);
+    } else {
+      gather_while_stepping(a, r0, r1, coll, *gather);
+    }
   }
   ++step_;
 }
 
+// step_gathering's loop for the rows [r0, r1) of one thread (all layers stepped, j0 = 0): the rows
+// a block at a time, and after each block the velocities of the runs whose rows read only rows
+// this thread has stepped (gather_lo_, gather_hi_), in the runs' order.
+template <class Args, class Coll>
+void Lattice::gather_while_stepping(const Args& a, int r0, int r1, const Coll& coll, const Gather& g) const {
+  const std::vector<NodeRun>& runs = *g.runs;
+  const std::size_t nx = static_cast<std::size_t>(config_.nx);
+  const std::int64_t after = step_ + 1;
+  auto row_of = [&](std::size_t k) { return static_cast<std::int32_t>(runs[k].first / nx); };
+  // The runs of rows [r0, r1).
+  std::size_t k = static_cast<std::size_t>(
+      std::partition_point(runs.begin(), runs.end(), [&](const NodeRun& run) { return run.first / nx < static_cast<std::size_t>(r0); }) -
+      runs.begin());
+  const std::size_t k_end = static_cast<std::size_t>(
+      std::partition_point(runs.begin(), runs.end(), [&](const NodeRun& run) { return run.first / nx < static_cast<std::size_t>(r1); }) -
+      runs.begin());
+  // A row reads rows within one layer (ny rows) and one row of itself, wrap apart: once a block
+  // ends at e, every row below e - ny - 1 has all its unwrapped sources stepped.
+  const int lag = config_.ny + 1;
+  constexpr int kBlock = 8;
+  for (int b = r0; b < r1; b += kBlock) {
+    const int e = std::min(b + kBlock, r1);
+    process_rows(a, b, e, coll);
+    const bool last = e == r1;
+    for (; k < k_end && (last || row_of(k) + lag < e); ++k) {
+      const std::int32_t row = row_of(k);
+      if (gather_lo_[static_cast<std::size_t>(row)] < r0 || gather_hi_[static_cast<std::size_t>(row)] >= e) continue;
+      velocities_of_run_after(runs[k].first, runs[k].count, g.u + 3 * runs[k].first, after);
+      g.done[k] = 1;
+    }
+  }
+}
+
 void Lattice::step() { step_layers(0, config_.ny); }
+
+void Lattice::step_gathering(const std::vector<NodeRun>& runs, double* u, std::vector<std::uint8_t>& done) {
+  done.assign(runs.size(), 0);
+  const Gather g{&runs, u, done.data()};
+  collide_stream_layers(0, config_.ny, &g);
+  correct_section_walls(0, config_.ny);
+}
 
 void Lattice::step_layers(int j0, int j1) {
   collide_stream_layers(j0, j1);
@@ -795,19 +886,21 @@ void Lattice::correct_section_walls(int j0, int j1) {
   apply_interpolated_bounce_back((step_ - 1) % 2 == 1, j0, j1);  // where the last step left its populations
 }
 
-void Lattice::collide_stream_layers(int j0, int j1) {
+void Lattice::collide_stream_layers(int j0, int j1) { collide_stream_layers(j0, j1, nullptr); }
+
+void Lattice::collide_stream_layers(int j0, int j1, const Gather* gather) {
   if (j0 < 0 || j1 > config_.ny || j0 >= j1)
     throw Error(fmt::format("LBM step of layers [{}, {}) outside the lattice's 0..{}", j0, j1, config_.ny));
   const double tau = config_.tau;
   if (collision_ == Collision::BGK && tau == 1.0) {
-    step_with(Bgk<true>{1.0, 0.5}, j0, j1);
+    step_with(Bgk<true>{1.0, 0.5}, j0, j1, gather);
   } else if (collision_ == Collision::BGK) {
-    step_with(Bgk<false>{1.0 / tau, 1.0 - 0.5 / tau}, j0, j1);
+    step_with(Bgk<false>{1.0 / tau, 1.0 - 0.5 / tau}, j0, j1, gather);
   } else if (collision_ == Collision::TRT) {
     // Lambda = (tau - 1/2)(1/omega- - 1/2).
-    step_with(Trt{1.0 / tau, 1.0 / (0.5 + config_.trt_magic / (tau - 0.5))}, j0, j1);
+    step_with(Trt{1.0 / tau, 1.0 / (0.5 + config_.trt_magic / (tau - 0.5))}, j0, j1, gather);
   } else {
-    step_with(Regularized{1.0 - 1.0 / tau, 1.0 - 0.5 / tau}, j0, j1);
+    step_with(Regularized{1.0 - 1.0 / tau, 1.0 - 0.5 / tau}, j0, j1, gather);
   }
 }
 
@@ -906,7 +999,9 @@ template <int q>
 
 }  // namespace
 
-void Lattice::velocities_of_run(std::size_t node, int count, double* u) const {
+void Lattice::velocities_of_run(std::size_t node, int count, double* u) const { velocities_of_run_after(node, count, u, step_); }
+
+void Lattice::velocities_of_run_after(std::size_t node, int count, double* u, std::int64_t steps) const {
   const std::size_t nx = static_cast<std::size_t>(config_.nx);
   const std::size_t row = node / nx;
   const int i0 = static_cast<int>(node - row * nx);
@@ -924,7 +1019,7 @@ void Lattice::velocities_of_run(std::size_t node, int count, double* u) const {
   double buffer[kQ][kChunk];
   const double* p[kQ];
   const std::int32_t* source = pull_rows_.data() + row * kQ;
-  const bool odd = step_ % 2 == 1;
+  const bool odd = steps % 2 == 1;
   for (int c0 = 0; c0 < count; c0 += kChunk) {
     const int m = std::min(kChunk, count - c0);
     const int i = i0 + c0;  // x of the chunk's first node

@@ -108,8 +108,7 @@ void LbmSuspension::step() {
     lattice_.clear_force();
     interpolator_.prepare(lattice_, X_, options_.kernel);  // X's stencils, for 2 and 4
     interpolator_.spread(lattice_, F_);
-    lattice_.step();
-    interpolator_.interpolate(lattice_, U_);
+    interpolator_.step_and_interpolate(lattice_, U_);  // the step, then U at X(t)
     euler_move(X_, U_, 1.0);
   } catch (const Error& e) {
     throw Error(fmt::format("suspension step {}: {}", n, e.what()));

@@ -73,6 +73,9 @@ class IbInterpolator {
   void spread(Lattice& lattice, const Points& F) const;
   /// interpolate_velocity through the prepared stencils (after the lattice's step).
   void interpolate(const Lattice& lattice, Points& U);
+  /// lattice.step(), then interpolate(lattice, U), bit for bit, with most of the gather done by
+  /// the step while the populations it reads are in cache (Lattice::step_gathering).
+  void step_and_interpolate(Lattice& lattice, Points& U);
   /// prepare(), then interpolate().
   void interpolate(const Lattice& lattice, const Points& X, Points& U, IbKernel kernel = IbKernel::Phi2);
 
@@ -85,11 +88,14 @@ class IbInterpolator {
   std::vector<std::uint64_t> marks_;   // a bit per lattice node: in some stencil
   std::vector<std::size_t> touched_;   // the marked nodes, ascending
   std::vector<double> velocity_;       // 3 per lattice node
-  struct Run {
-    std::size_t first;  // a node
-    int count;          // consecutive nodes of its x-row from it
-  };
-  std::vector<Run> runs_;  // touched_ in runs
+  std::vector<Lattice::NodeRun> runs_;  // touched_ in runs of consecutive nodes of one x-row
+  std::vector<std::uint8_t> gathered_;  // per run: its velocities computed by the step
+  // touched_ and runs_ from the stencils (by prepare).
+  void plan_runs(const Lattice& lattice);
+  // The velocities of the runs not gathered yet (all when `gathered_` is empty).
+  void gather_runs(const Lattice& lattice);
+  // U from the stencils and the gathered velocities.
+  void sum_stencils(Points& U) const;
 };
 
 /// X <- X + dt U.

@@ -165,8 +165,17 @@ class Lattice {
   double* force_field_for_writing() {
     force_everywhere_ = true;
     forced_.clear();
+    forced_runs_.clear();
     return force_.data();
   }
+  /// `count` consecutive nodes of one x-row from node `first`.
+  struct NodeRun {
+    std::size_t first;
+    int count;
+  };
+  /// The same for a writer that adds to the nodes of `within` only: the next clear_force clears
+  /// those runs (all of the field once the runs written since the last clear cover half of it).
+  double* force_field_for_writing(const std::vector<NodeRun>& within);
   Vec3 force(std::size_t node) const {
     const double* f = force_.data();
     return {f[node], f[stride_ + node], f[2 * stride_ + node]};
@@ -177,6 +186,15 @@ class Lattice {
   /// One step: collide with the force field (Guo), stream, bounce back at the walls. OpenMP over
   /// the (y, z) rows.
   void step();
+  /// step(), which also computes, for the runs (ascending, each in one x-row) whose populations
+  /// are final before the step ends, velocities_of_run(run.first, run.count, u + 3 * run.first) as
+  /// it would after the step, bit for bit, and sets done[k] to 1 for those (0 for the others).
+  /// A thread computes a run's velocities once it has stepped every row the run's row reads from,
+  /// while those rows are still in its cache; without that, the immersed boundary's gather read
+  /// them back from memory after the step, at about the cost of the step itself. Left for the
+  /// caller (done[k] = 0): rows whose neighbours another thread steps, and rows next to a wall
+  /// link, which the wall pass changes after the collision.
+  void step_gathering(const std::vector<NodeRun>& runs, double* u, std::vector<std::uint8_t>& done);
   /// One step of the layers j0 <= j < j1 only; the others keep their populations. For a
   /// subdomain whose layers j0 - 1 and j1 are ghost copies of a neighbour's (kept by the caller,
   /// parallel/distributed_lattice.hpp): a stepped layer then never wraps around in y.
@@ -227,8 +245,21 @@ class Lattice {
   void restore_raw(const std::vector<double>& populations, std::int64_t step);
 
  private:
+  // step_gathering's part of the step: the runs, the velocities and the flags.
+  struct Gather {
+    const std::vector<NodeRun>* runs;
+    double* u;
+    std::uint8_t* done;
+  };
   template <class Coll>
-  void step_with(const Coll& coll, int j0, int j1);
+  void step_with(const Coll& coll, int j0, int j1, const Gather* gather = nullptr);
+  void collide_stream_layers(int j0, int j1, const Gather* gather);
+  template <class Args, class Coll>
+  void gather_while_stepping(const Args& a, int r0, int r1, const Coll& coll, const Gather& g) const;
+  /// velocities_of_run after `steps` steps (the parity of the AA layout), whatever step_ is.
+  void velocities_of_run_after(std::size_t node, int count, double* u, std::int64_t steps) const;
+  /// gather_lo_, gather_hi_ (below), from pull_rows_ and wall_links_.
+  void build_gather_rows();
   void build_section();
   /// pull_rows_ (below).
   void build_pull_rows();
@@ -248,6 +279,8 @@ class Lattice {
   // immersed boundary touches does not sweep the whole field every step; everywhere once the
   // list would exceed num_nodes() / 8 or after set_uniform_force.
   std::vector<std::size_t> forced_;
+  std::vector<NodeRun> forced_runs_;  // and the runs given to force_field_for_writing
+  std::size_t forced_run_nodes_ = 0;  // their nodes
   bool force_everywhere_ = false;
   // The cross-section: solid flag per row (j + ny k), empty without one, and the links of fluid
   // rows into solid rows with the wall fraction q and whether the row behind (x_f - c_q) is fluid.
@@ -262,6 +295,10 @@ class Lattice {
   // source row (j - c_qy, k - c_qz wrapped), or one of the codes below (populations()).
   static constexpr std::int32_t kPullSolid = -1, kPullBottomWall = -2, kPullTopWall = -3;
   std::vector<std::int32_t> pull_rows_;
+  // Per row: the lowest and highest row whose stepping writes populations that the row's velocity
+  // reads (the row itself and its source rows); a row beside a wall link has hi = INT32_MAX, for
+  // the wall pass changes it after the collision (step_gathering).
+  std::vector<std::int32_t> gather_lo_, gather_hi_;
   std::vector<WallLink> wall_links_;
   std::vector<double> wall_buffer_;
   std::size_t fluid_nodes_ = 0;
