@@ -68,17 +68,9 @@ void MeshGeometry::compute(const Topology& t, const Points& x, MeshGeometry& g) 
   }
 
   const IndexPairs& ef = t.edge_faces();
-  const Faces& fe = t.face_edges();
+  const IndexPairs& ec = t.edge_opposite_corners();
 #pragma omp parallel for schedule(static)
-  for (int e = 0; e < ne; ++e) {
-    double w = 0;
-    for (int s = 0; s < 2; ++s) {
-      const int f = ef(e, s);
-      for (int k = 0; k < 3; ++k)
-        if (fe(f, k) == e) w += g.corner_cot(f, k);
-    }
-    g.edge_cot_weight[e] = w;
-  }
+  for (int e = 0; e < ne; ++e) g.edge_cot_weight[e] = g.corner_cot(ef(e, 0), ec(e, 0)) + g.corner_cot(ef(e, 1), ec(e, 1));
 
   const auto& rf = t.ring_faces();
   const auto& rc = t.ring_corners();

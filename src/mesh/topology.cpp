@@ -75,6 +75,7 @@ std::shared_ptr<const Topology> Topology::build(int num_vertices, const Faces& f
   t.edge_vertices_.resize(ne, 2);
   t.edge_faces_.resize(ne, 2);
   t.edge_opposite_.resize(ne, 2);
+  t.edge_opposite_corners_.resize(ne, 2);
   t.face_edges_.resize(nf, 3);
   int e = 0;
   for (size_t s = 0; s < half.size();) {
@@ -99,6 +100,7 @@ std::shared_ptr<const Topology> Topology::build(int num_vertices, const Faces& f
     t.edge_vertices_.row(e) << a, b;
     t.edge_faces_.row(e) << h0.face, h1.face;
     t.edge_opposite_.row(e) << faces(h0.face, h0.corner), faces(h1.face, h1.corner);
+    t.edge_opposite_corners_.row(e) << h0.corner, h1.corner;
     t.face_edges_(h0.face, h0.corner) = e;
     t.face_edges_(h1.face, h1.corner) = e;
     ++e;

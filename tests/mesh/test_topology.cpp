@@ -53,6 +53,7 @@ TEST(Topology, EdgeFacesAndOpposites) {
       int c = 0;
       while (t.faces()(f, c) != o) ++c;
       EXPECT_EQ(t.face_edges()(f, c), e);
+      EXPECT_EQ(t.edge_opposite_corners()(e, s), c);
       // f0 traverses a -> b, f1 traverses b -> a.
       const int from = t.faces()(f, (c + 1) % 3), to = t.faces()(f, (c + 2) % 3);
       EXPECT_EQ(from, s == 0 ? a : b);

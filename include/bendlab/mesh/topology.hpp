@@ -37,6 +37,8 @@ class Topology {
   const IndexPairs& edge_vertices() const { return edge_vertices_; }
   const IndexPairs& edge_faces() const { return edge_faces_; }
   const IndexPairs& edge_opposite() const { return edge_opposite_; }
+  /// The corners (0..2) of edge_faces(e) at edge_opposite(e): face_edges(f_s, corner) == e.
+  const IndexPairs& edge_opposite_corners() const { return edge_opposite_corners_; }
   const Faces& face_edges() const { return face_edges_; }
 
   int ring_begin(int i) const { return ring_offsets_[i]; }
@@ -77,7 +79,7 @@ class Topology {
   Identity id_;
   int num_vertices_ = 0;
   Faces faces_;
-  IndexPairs edge_vertices_, edge_faces_, edge_opposite_;
+  IndexPairs edge_vertices_, edge_faces_, edge_opposite_, edge_opposite_corners_;
   Faces face_edges_;
   std::vector<int> ring_offsets_, ring_vertices_, ring_faces_, ring_edges_, ring_corners_;
 };
