@@ -22,6 +22,7 @@ and 6 small stiff cells, every force updated every step):
     bench_suspension, run alternately with this one in the same run) the same before, with the
     ratios: targets at most 4.2 fluid steps on the pipeflow case and 1.7 times the one-thread step
     on two threads;
+  - the step table also as the section "Suspension step" of docs/benchmarks.md (--benchmarks-doc);
   - docs/results/hemocell_like_for_like.md (scripts/hemocell_like_for_like.py, which needs a HemoCell
     build) and docs/results/membrane_every.md (scripts/membrane_every_study.py), included as they stand.
 Every figure is the median over the runs; the load average before and after is recorded. The
@@ -78,6 +79,8 @@ def main():
     p.add_argument("--save-json", default=None,
                    help="a folder to keep this run's reports in (after.N.json, before.N.json) for --json")
     p.add_argument("--out", default="docs/results/suspension_performance.md")
+    p.add_argument("--benchmarks-doc", default="docs/benchmarks.md",
+                   help="where the step table also goes, as its section (empty: nowhere)")
     a = p.parse_args()
     before_reports = []
     load_start = load_average()
@@ -151,6 +154,7 @@ def main():
             L.append(f"| {t} | {row['steps_per_second']:.1f} | {row['cells']:.0f} | {row['vertices']:.0f} |")
     # The step in fluid steps, before and after.
     mb = medians(before_reports) if before_reports else {}
+    step_start = len(L) + 3  # the table's description and rows, also written to docs/benchmarks.md
     L += ["", "## The step in fluid steps", "",
           "CPU cost of a whole step over that of the fluid step alone on the same lattice (real time, one "
           "process), on the pipeflow case above and on the tube study's reference case (D = 10 um, 20 um periodic, "
@@ -183,6 +187,7 @@ def main():
             one = m.get((f"BM_{family}Step", 1))
             cells.append(f"{ms(one) / ms(step):.2f}" if t == 2 and one and "error" not in one else "")
             L.append("| " + " | ".join(cells) + " |")
+    step_table = L[step_start:]
     mem = m.get(("BM_ExtraCellMemory", None))
     L += ["", "Memory per extra cell (the heap in use, glibc's mallinfo2, grown when 20 red blood cells of 642 "
           "vertices join the pipeflow case and it steps twice):", ""]
@@ -210,6 +215,31 @@ def main():
         f.write("\n".join(L))
     os.replace(tmp, a.out)
     print(f"make_suspension_performance_doc: wrote {a.out}")
+    if a.benchmarks_doc and os.path.exists(a.benchmarks_doc):
+        write_benchmarks_section(a.benchmarks_doc, step_table, load_start, load_end)
+        print(f"make_suspension_performance_doc: wrote its section of {a.benchmarks_doc}")
+
+
+SECTION = "## Suspension step (`bench_suspension`)"
+
+
+def write_benchmarks_section(path, table, load_before, load_after):
+    """Replaces (or inserts before "## Running one benchmark") the suspension section of docs/benchmarks.md."""
+    with open(path) as f:
+        lines = f.read().split("\n")
+    section = [SECTION, "", "Written by `scripts/make_suspension_performance_doc.py` (the full account, with HemoCell "
+               "beside it, is docs/results/suspension_performance.md); load average "
+               f"{load_before} before, {load_after} after.", ""] + table + [""]
+    if SECTION in lines:
+        start = lines.index(SECTION)
+        end = next((k for k in range(start + 1, len(lines)) if lines[k].startswith("## ")), len(lines))
+    else:
+        start = end = next((k for k, line in enumerate(lines) if line.startswith("## Running one benchmark")), len(lines))
+    lines[start:end] = section
+    tmp = path + ".tmp"
+    with open(tmp, "w") as f:
+        f.write("\n".join(lines))
+    os.replace(tmp, path)
 
 
 if __name__ == "__main__":
