@@ -157,7 +157,7 @@ def main():
     step_start = len(L) + 3  # the table's description and rows, also written to docs/benchmarks.md
     L += ["", "## The step in fluid steps", "",
           "CPU cost of a whole step over that of the fluid step alone on the same lattice (real time, one "
-          "process), on the pipeflow case above and on the tube study's reference case (D = 10 um, 20 um periodic, "
+          "process), on the pipeflow case (HemoCell's pipeflow tube, bench/pipeflow_case.hpp) and on the tube study's reference case (D = 10 um, 20 um periodic, "
           "tau = 1.82, 5 red blood cells of 1280 triangles, time scale 10: 40 x 24 x 24 nodes). "
           + (f"Before: {a.before_label}, run alternately with this one in the same run. "
              if before_reports else "No earlier build was measured in this run. ")
